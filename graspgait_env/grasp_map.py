@@ -1,0 +1,221 @@
+"""Grasp maps (thesis 2.3 "The Grasp Map", 3.2).
+
+``stable[i, j]`` is True when fingers at ``phi_i`` and ``phi_j`` (object frame ``f``)
+make a force-closure two-point grasp with Coulomb friction ``mu``, where
+``phi_k = 360 k / n`` degrees (default ``n = 180``: 2°, as in the thesis). The map is
+symmetric and its diagonal is False. A contact exactly on a polygon vertex has no
+defined normal and is never part of a stable grasp. Contacts beyond a reach limit
+(``max_radius``, thesis 4.2 and fig. 4.3) are marked unusable: their rows and columns
+are False.
+
+The *extended grasp map* (thesis fig. 3.3) repeats the map every 360° in both axes.
+:meth:`GraspMap.extended` and :meth:`GraspMap.window` return read-only **views** of
+one 2 × 2 tiling whose top-left block *is* ``stable``, so no copy is made per call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from graspgait_env.force_closure import check_mu, force_closure_nguyen, force_closure_wrench
+from graspgait_env.shapes import Shape
+
+__all__ = ["GraspMap", "grasp_map", "grasp_map_loop", "grid_angles_deg", "check_n"]
+
+
+def check_n(n: int) -> int:
+    """Validate the number of contacts on the grid: an integer >= 4."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 4:
+        raise ValueError(f"n={n!r}: must be an integer >= 4 (grid points on the contour), e.g. 180")
+    return int(n)
+
+
+def grid_angles_deg(n: int) -> NDArray[np.float64]:
+    """Contact angles of the grid, ``phi_k = 360 k / n`` degrees, k = 0..n-1."""
+    return 360.0 * np.arange(check_n(n)) / n
+
+
+@dataclass(frozen=True, eq=False)
+class GraspMap:
+    """A boolean grasp map with its angles.
+
+    Attributes
+    ----------
+    stable
+        ``(n, n)`` bool, ``stable[i, j]`` for contacts at ``phi_deg[i]``, ``phi_deg[j]``.
+        Read-only.
+    phi_deg
+        ``(n,)`` contact angles (degrees, object frame).
+    mu
+        Friction coefficient the map was computed for.
+    shape_name
+        Name of the object.
+    usable
+        ``(n,)`` bool: contacts that are within reach and not on a vertex.
+    """
+
+    stable: NDArray[np.bool_]
+    phi_deg: NDArray[np.float64]
+    mu: float
+    shape_name: str
+    usable: NDArray[np.bool_]
+    _tiled: NDArray[np.bool_] = field(repr=False)
+
+    @property
+    def n(self) -> int:
+        """Number of contacts on the grid."""
+        return len(self.phi_deg)
+
+    @property
+    def step_deg(self) -> float:
+        """Grid spacing (degrees)."""
+        return 360.0 / self.n
+
+    def __array__(self, dtype=None, copy=None):
+        return self.stable if dtype is None else self.stable.astype(dtype)
+
+    def window(self, i0: int, j0: int, size: int) -> NDArray[np.bool_]:
+        """View of the extended map: rows ``i0..i0+size-1``, columns ``j0..j0+size-1``.
+
+        Indices wrap modulo ``n`` (so ``i0`` may be negative or beyond ``n``);
+        ``size <= n``. The result shares memory with :attr:`stable`.
+        """
+        if not 0 < size <= self.n:
+            raise ValueError(f"size={size}: must be in 1..n={self.n}")
+        i0 %= self.n
+        j0 %= self.n
+        return self._tiled[i0 : i0 + size, j0 : j0 + size]
+
+    def extended(self) -> NDArray[np.bool_]:
+        """The extended grasp map over [0°, 720°)² (thesis fig. 3.3), a read-only view."""
+        return self._tiled
+
+    def fraction_stable(self) -> float:
+        """Fraction of the map's cells that are stable."""
+        return float(self.stable.mean())
+
+
+def _make(stable: NDArray[np.bool_], phi: NDArray[np.float64], mu: float, name: str,
+          usable: NDArray[np.bool_]) -> GraspMap:
+    tiled = np.tile(stable, (2, 2))
+    tiled.flags.writeable = False
+    n = len(phi)
+    view = tiled[:n, :n]
+    usable = usable.copy()
+    usable.flags.writeable = False
+    phi = phi.copy()
+    phi.flags.writeable = False
+    return GraspMap(view, phi, mu, name, usable, tiled)
+
+
+def _usable(shape: Shape, phi: NDArray[np.float64], max_radius: float | None) -> NDArray[np.bool_]:
+    usable = ~shape.is_vertex(phi)
+    if max_radius is not None:
+        if not (math.isfinite(max_radius) and max_radius > 0):
+            raise ValueError(f"max_radius={max_radius!r}: must be a finite length > 0 (m)")
+        usable &= shape.radius(phi) <= max_radius
+    return usable
+
+
+def grasp_map(
+    shape: Shape,
+    mu: float,
+    n: int = 180,
+    *,
+    max_radius: float | None = None,
+    method: str = "nguyen",
+) -> GraspMap:
+    """Compute the grasp map of ``shape`` at friction ``mu`` on an ``n``-point grid.
+
+    Parameters
+    ----------
+    shape
+        A star-shaped object (see :mod:`graspgait_env.shapes`); a name or YAML path is
+        loaded with :func:`graspgait_env.load_object`.
+    mu
+        Coulomb friction coefficient (> 0).
+    n
+        Contacts on the contour, ``phi_k = 360 k / n`` degrees (default 180: 2°).
+    max_radius
+        Reach limit (m, thesis 4.2, fig. 4.3): contacts whose radius exceeds it are
+        unusable and never part of a stable grasp. ``None``: no limit.
+    method
+        ``"nguyen"`` (geometric, default, fastest) or ``"wrench"`` (thesis 3.2).
+
+    Returns
+    -------
+    GraspMap
+        ``.stable`` is the ``(n, n)`` boolean map; ``.phi_deg`` its angles.
+
+    Examples
+    --------
+    >>> from graspgait_env.shapes import Circle
+    >>> gm = grasp_map(Circle(0.05), mu=0.3, n=12)
+    >>> bool(gm.stable[0, 6]), bool(gm.stable[0, 5]), bool(gm.stable[0, 0])
+    (True, False, False)
+    """
+    if not isinstance(shape, Shape):
+        from graspgait_env.objects import load_object
+
+        shape = load_object(shape)
+    mu = check_mu(mu)
+    phi = grid_angles_deg(n)
+    P = shape.contour_point(phi)
+    N = shape.inward_normal(phi)
+    if method == "nguyen":
+        # thesis 3.2 via Nguyen: d_ij = p_j - p_i must lie inside both friction cones,
+        # d_ij . n_i > cos(atan mu) |d_ij| and -d_ij . n_j > cos(atan mu) |d_ij|.
+        # With M = N P^T (M_ij = n_i . p_j) and h_i = n_i . p_i, d_ij . n_i = M_ij - h_i
+        # and -d_ij . n_j = M_ji - h_j; |d_ij|^2 comes from the Gram matrix. Two small
+        # matrix products instead of an (n, n, 2) tensor: no division, no arccos.
+        cos_a = math.cos(math.atan(mu))
+        M = N @ P.T
+        h = np.diagonal(M)
+        G = P @ P.T
+        sq = np.diagonal(G)
+        lim = np.sqrt(np.maximum(sq[:, None] + sq[None, :] - 2.0 * G, 0.0))
+        lim *= cos_a
+        A = M - h[:, None]
+        stable = (A > lim) & (A.T > lim)
+    elif method == "wrench":
+        I, J = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+        stable = force_closure_wrench(P[I], N[I], P[J], N[J], mu)
+    else:
+        raise ValueError(f"method={method!r}: use 'nguyen' or 'wrench'")
+    usable = _usable(shape, phi, max_radius)
+    stable &= usable[:, None] & usable[None, :]
+    np.fill_diagonal(stable, False)
+    return _make(stable, phi, mu, shape.name, usable)
+
+
+def grasp_map_loop(shape: Shape, mu: float, n: int = 180) -> GraspMap:
+    """Reference implementation: one Python-level force-closure test per pair.
+
+    Kept as the yardstick for ``graspgait perf`` (the vectorized map must be >= 10×
+    faster) and as an independent check in the tests. Same result as :func:`grasp_map`.
+    """
+    mu = check_mu(mu)
+    phi = grid_angles_deg(n)
+    P = shape.contour_point(phi).tolist()
+    N = shape.inward_normal(phi).tolist()
+    usable = _usable(shape, phi, None)
+    cos_a = math.cos(math.atan(mu))
+    stable = np.zeros((n, n), dtype=bool)
+    for i in range(n):
+        if not usable[i]:
+            continue
+        (xi, yi), (nxi, nyi) = P[i], N[i]
+        for j in range(n):
+            if j == i or not usable[j]:
+                continue
+            dx, dy = P[j][0] - xi, P[j][1] - yi
+            dist = math.hypot(dx, dy)
+            stable[i, j] = (
+                dx * nxi + dy * nyi > cos_a * dist
+                and -(dx * N[j][0] + dy * N[j][1]) > cos_a * dist
+            )
+    return _make(stable, phi, mu, shape.name, usable)
