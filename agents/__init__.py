@@ -1,0 +1,1 @@
+"""PPO agents trained on gait discovery and their comparison against the baselines."""

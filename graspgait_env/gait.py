@@ -1,0 +1,276 @@
+"""The gait model: states, rotate/regrasp moves and the legal-move function (thesis 4.3, 5.2).
+
+Discretization
+--------------
+Contacts lie on the grasp map's grid, ``phi_c = 360 c / n`` degrees (object frame), and
+the object angle is ``theta = 360 k / n`` degrees: rotations move in steps of the same
+grid (2° by default, as in the thesis's searches, 5.2), so a contact on the grid stays
+on the grid in the workspace frame ``F``. ``n`` configures both; the thesis's Δx = Δy = Δθ
+choice is kept. A contact ``c`` held at object angle ``k`` lies at ``F`` grid index
+``(c + k) mod n``. A finger's workspace is the set of ``F`` grid angles inside its arc;
+positions ``p = 0 .. W_f - 1`` count grid steps from the first of them.
+
+State
+-----
+``(k, c_1, c_2, c_3)``: the object angle in grid steps (an unbounded integer: the turn
+achieved so far is ``k * 360 / n`` degrees, counter-clockwise positive) and the contact
+of each finger, ``-1`` for the free finger. Exactly two fingers hold the object.
+In the thesis's terms (5.2) ``X = [theta, x, y]`` with the fingers implied by the
+workspaces; we name the fingers explicitly since the action space does.
+
+Moves (DESIGN.md)
+-----------------
+- **rotate** by ``±j`` grid steps: both contacts stay inside their fingers' workspaces
+  all the way (thesis 5.2, fig. 5.1; either direction).
+- **regrasp**: the free finger is placed at a grid contact reachable now (inside its
+  workspace at the present angle), then one of the two old fingers is lifted; the new
+  pair must be force-closure (thesis 4.2: one contact kept, a horizontal or vertical
+  move in the map, into another finger pair box).
+
+Action layout (one discrete space for the planners and the Gymnasium envs)
+----------------------------------------------------------------------------
+With ``R = max_f W_f - 1`` (the longest rotation) and ``P = max_f W_f``:
+
+- ``0 .. R-1``: rotate counter-clockwise by ``a + 1`` steps;
+- ``R .. 2R-1``: rotate clockwise by ``a - R + 1`` steps;
+- ``2R + 2 p + l``: regrasp — put the free finger at position ``p`` of its workspace and
+  lift the held finger with the lower (``l = 0``) or higher (``l = 1``) number.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.grasp_map import GraspMap, check_n, grasp_map
+from graspgait_env.objects import load_object
+from graspgait_env.shapes import Shape
+from graspgait_env.workspace import Hand, load_hand
+
+__all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP"]
+
+ROTATE = "rotate"
+REGRASP = "regrasp"
+
+
+class GaitState(NamedTuple):
+    """``(k, contacts)``: object angle in grid steps and each finger's contact (-1: free)."""
+
+    k: int
+    contacts: tuple[int, ...]
+
+    def held(self) -> tuple[int, ...]:
+        """Fingers (0-based) on the object, ascending."""
+        return tuple(f for f, c in enumerate(self.contacts) if c >= 0)
+
+
+@dataclass(frozen=True)
+class Move:
+    """A decoded action: ``kind`` rotate (``delta`` grid steps, CCW positive) or regrasp
+    (``finger`` placed at ``contact``, ``lifted`` removed; fingers 0-based)."""
+
+    kind: str
+    delta: int = 0
+    finger: int = -1
+    contact: int = -1
+    lifted: int = -1
+
+
+class GaitModel:
+    """The discretized grasp-gait problem for one object, friction and hand.
+
+    Parameters
+    ----------
+    shape
+        Object (a :class:`~graspgait_env.shapes.Shape`, bundled name or YAML path).
+    mu
+        Coulomb friction coefficient (> 0).
+    hand
+        :class:`~graspgait_env.workspace.Hand`, a bundled hand name or YAML path;
+        default the thesis hand of fig. 4.1. Exactly three fingers.
+    n
+        Grid size: contacts and rotations in steps of ``360 / n`` degrees (default 180).
+    max_radius
+        Reach cap (m) for the grasp map (thesis fig. 4.3); a reach hand supplies its own.
+
+    Attributes
+    ----------
+    stable
+        The ``(n, n)`` grasp map.
+    ws_start, ws_width
+        Per finger (0-based): unwrapped ``F`` grid index of workspace position 0, and
+        the number ``W_f`` of grid angles in the workspace.
+    n_actions
+        Size of the discrete action space (see module docstring).
+    """
+
+    def __init__(self, shape: Shape | str, mu: float, hand: Hand | str | None = None,
+                 n: int = 180, max_radius: float | None = None) -> None:
+        self.shape = load_object(shape)
+        self.n = check_n(n)
+        self.hand, hand_cap = load_hand(hand, self.shape)
+        if self.hand.n_fingers != 3:
+            raise GraspGaitInputError(
+                f"hand {self.hand.name!r}: has {self.hand.n_fingers} fingers; the gait model "
+                "needs exactly 3 (two hold, one regrasps)")
+        cap = max_radius if max_radius is not None else hand_cap
+        self.max_radius = cap
+        self.mu = float(mu)
+        self.grasp_map: GraspMap = grasp_map(self.shape, mu, self.n, max_radius=cap)
+        self.stable: NDArray[np.bool_] = self.grasp_map.stable
+        self.step_deg = 360.0 / self.n
+        starts, widths = [], []
+        for f, (lo, hi) in enumerate(self.hand.workspaces_deg):
+            a0 = math.ceil(lo / self.step_deg - 1e-9)
+            a1 = math.floor(hi / self.step_deg + 1e-9)
+            if a1 < a0:
+                raise GraspGaitInputError(
+                    f"workspaces_deg[{f}]={[lo, hi]}: holds no grid angle at n={self.n}; "
+                    "widen the workspace or raise n")
+            starts.append(a0)
+            widths.append(a1 - a0 + 1)
+        self.ws_start = np.array(starts, dtype=np.int64)
+        self.ws_width = np.array(widths, dtype=np.int64)
+        self.R = int(self.ws_width.max()) - 1
+        self.P = int(self.ws_width.max())
+        self.n_actions = 2 * self.R + 2 * self.P
+        self._positions = np.arange(self.P)
+
+    # ----------------------------------------------------------------- geometry
+    def position(self, finger: int, contact: int, k: int) -> int:
+        """Workspace position of ``finger`` holding ``contact`` at angle ``k``; -1 if outside."""
+        p = (contact + k - int(self.ws_start[finger])) % self.n
+        return int(p) if p < self.ws_width[finger] else -1
+
+    def is_legal_state(self, s: GaitState) -> bool:
+        """Two fingers hold a stable grasp with both contacts inside their workspaces."""
+        held = s.held()
+        if len(held) != 2 or len(s.contacts) != 3:
+            return False
+        f, g = held
+        return (bool(self.stable[s.contacts[f], s.contacts[g]])
+                and self.position(f, s.contacts[f], s.k) >= 0
+                and self.position(g, s.contacts[g], s.k) >= 0)
+
+    def contact_deg(self, c: int) -> float:
+        """Object-frame angle (degrees) of grid contact ``c``."""
+        return (c % self.n) * self.step_deg
+
+    def contact_index(self, phi_deg: float) -> int:
+        """Grid index of an object-frame angle; refuses angles off the grid."""
+        x = phi_deg / self.step_deg
+        c = round(x)
+        if abs(x - c) > 1e-6:
+            raise GraspGaitInputError(
+                f"contact {phi_deg} deg: not on the {self.step_deg:g}-degree grid; "
+                f"give a multiple of {self.step_deg:g}")
+        return int(c) % self.n
+
+    def start_state(self, contacts: dict[int, float]) -> GaitState:
+        """State at ``theta = 0`` from ``{finger (1-based): phi_deg}`` with two fingers.
+
+        Raises
+        ------
+        GraspGaitInputError
+            Not two fingers, an unknown finger, a contact outside its finger's workspace,
+            or a pair that is not force-closure — each named with the fix.
+        """
+        if len(contacts) != 2:
+            raise GraspGaitInputError(
+                f"start grasp {contacts}: needs exactly two fingers; give e.g. {{1: 50, 3: 270}}")
+        cs = [-1, -1, -1]
+        for f, phi in contacts.items():
+            if f not in (1, 2, 3):
+                raise GraspGaitInputError(f"start grasp finger {f}: fingers are 1, 2, 3")
+            c = self.contact_index(phi)
+            if self.position(f - 1, c, 0) < 0:
+                lo, hi = self.hand.workspaces_deg[f - 1]
+                raise GraspGaitInputError(
+                    f"start grasp: finger {f} at {phi} deg is outside its workspace [{lo}, {hi}]")
+            cs[f - 1] = c
+        s = GaitState(0, tuple(cs))
+        f, g = s.held()
+        if not self.stable[cs[f], cs[g]]:
+            raise GraspGaitInputError(
+                f"start grasp {contacts}: not force-closure at mu={self.mu}; pick a stable "
+                "pair (see `graspgait map`)")
+        return s
+
+    def start_states(self) -> list[GaitState]:
+        """Every legal grasp at ``theta = 0`` (all finger pairs), in a fixed order."""
+        out = []
+        for f, g in ((0, 1), (0, 2), (1, 2)):
+            cf = (self.ws_start[f] + np.arange(self.ws_width[f])) % self.n
+            cg = (self.ws_start[g] + np.arange(self.ws_width[g])) % self.n
+            ok = self.stable[np.ix_(cf, cg)]
+            for i, j in zip(*np.nonzero(ok), strict=True):
+                cs = [-1, -1, -1]
+                cs[f], cs[g] = int(cf[i]), int(cg[j])
+                out.append(GaitState(0, tuple(cs)))
+        return out
+
+    # ----------------------------------------------------------------- moves
+    def action_mask(self, s: GaitState) -> NDArray[np.bool_]:
+        """Exactly the legal actions of state ``s`` (thesis 5.2 branching), vectorized.
+
+        Every planner and both environments use this one function.
+        """
+        mask = np.zeros(self.n_actions, dtype=bool)
+        f, g = s.held()
+        h = 3 - f - g
+        pf = self.position(f, s.contacts[f], s.k)
+        pg = self.position(g, s.contacts[g], s.k)
+        ccw = min(self.ws_width[f] - 1 - pf, self.ws_width[g] - 1 - pg)
+        cw = min(pf, pg)
+        mask[:ccw] = True
+        mask[self.R : self.R + cw] = True
+        W = int(self.ws_width[h])
+        cand = (self.ws_start[h] + self._positions[:W] - s.k) % self.n
+        reg = mask[2 * self.R :].reshape(self.P, 2)
+        reg[:W, 0] = self.stable[cand, s.contacts[g]]  # lift f (lower number), keep g
+        reg[:W, 1] = self.stable[cand, s.contacts[f]]  # lift g (higher number), keep f
+        return mask
+
+    def decode(self, s: GaitState, action: int) -> Move:
+        """The move that ``action`` names in state ``s`` (legal or not)."""
+        a = int(action)
+        if not 0 <= a < self.n_actions:
+            raise ValueError(f"action={a}: must be in 0..{self.n_actions - 1}")
+        if a < self.R:
+            return Move(ROTATE, delta=a + 1)
+        if a < 2 * self.R:
+            return Move(ROTATE, delta=-(a - self.R + 1))
+        p, lift = divmod(a - 2 * self.R, 2)
+        f, g = s.held()
+        h = 3 - f - g
+        return Move(REGRASP, finger=h, contact=int((self.ws_start[h] + p - s.k) % self.n),
+                    lifted=(f, g)[lift])
+
+    def apply(self, s: GaitState, action: int) -> GaitState:
+        """The state after ``action`` (assumed legal: check :meth:`action_mask` first)."""
+        m = self.decode(s, action)
+        if m.kind == ROTATE:
+            return GaitState(s.k + m.delta, s.contacts)
+        cs = list(s.contacts)
+        cs[m.finger] = m.contact
+        cs[m.lifted] = -1
+        return GaitState(s.k, tuple(cs))
+
+    def successors(self, s: GaitState) -> list[tuple[int, GaitState]]:
+        """``(action, next_state)`` for every legal action of ``s``."""
+        return [(int(a), self.apply(s, int(a))) for a in np.flatnonzero(self.action_mask(s))]
+
+    def turn_steps(self, turn_deg: float) -> int:
+        """The requested turn in grid steps (rounded away from zero to the grid)."""
+        x = turn_deg / self.step_deg
+        return int(math.ceil(x - 1e-9)) if x >= 0 else int(math.floor(x + 1e-9))
+
+    def describe_state(self, s: GaitState) -> str:
+        """``theta=40.0 deg, fingers {1: 50.0, 3: 270.0}``."""
+        held = {f + 1: self.contact_deg(s.contacts[f]) for f in s.held()}
+        return f"theta={s.k * self.step_deg:g} deg, fingers {held}"
