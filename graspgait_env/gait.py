@@ -261,6 +261,24 @@ class GaitModel:
         cs[m.lifted] = -1
         return GaitState(s.k, tuple(cs))
 
+    def encode(self, s: GaitState, t: GaitState) -> int:
+        """The action taking ``s`` to ``t`` (one move); raises ValueError if none does."""
+        if t.contacts == s.contacts and t.k != s.k:
+            d = t.k - s.k
+            if 0 < d <= self.R:
+                return d - 1
+            if 0 < -d <= self.R:
+                return self.R - d - 1
+        elif t.k == s.k:
+            f, g = s.held()
+            h = 3 - f - g
+            lifted = [x for x in (f, g) if t.contacts[x] < 0]
+            if len(lifted) == 1 and t.contacts[h] >= 0:
+                p = self.position(h, t.contacts[h], s.k)
+                if p >= 0:
+                    return 2 * self.R + 2 * p + (0 if lifted[0] == f else 1)
+        raise ValueError(f"no single move takes {s} to {t}")
+
     def successors(self, s: GaitState) -> list[tuple[int, GaitState]]:
         """``(action, next_state)`` for every legal action of ``s``."""
         return [(int(a), self.apply(s, int(a))) for a in np.flatnonzero(self.action_mask(s))]

@@ -1,0 +1,246 @@
+"""The ``graspgait`` command line (DESIGN.md, "Command line").
+
+::
+
+    graspgait map OBJECT --mu 0.7 [--n 180] [--theta 0] [--hand thesis] [--png F] [--npy F]
+    graspgait sweep eccentricity|smoothness [--n 180] [--png F]
+    graspgait perf [--repeat 100] [--json F]
+
+Exit status: 0 on success; 2 on bad input (an argument, a file, a field), with one
+line ``graspgait: error: <message>`` on stderr and no traceback; 1 when a question has
+no answer (:class:`~graspgait_env.errors.NoGaitError`).
+
+Subcommands are registered in :data:`SUBCOMMANDS`: each entry is a function that adds
+its parser to the subparsers and sets ``func`` (the handler, ``args -> int``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from graspgait_env.errors import GraspGaitInputError, NoGaitError
+
+__all__ = ["main", "build_parser", "SUBCOMMANDS"]
+
+PROG = "graspgait"
+
+
+def _input_error(flag: str, exc: ValueError) -> GraspGaitInputError:
+    """A library ValueError about a numeric argument, as a user error naming the flag."""
+    return GraspGaitInputError(f"{flag}: {exc}")
+
+
+def _check_mu(mu: float) -> float:
+    from graspgait_env.force_closure import check_mu
+
+    try:
+        return check_mu(mu)
+    except ValueError as exc:
+        raise _input_error("--mu", exc) from None
+
+
+def _check_n(n: int) -> int:
+    from graspgait_env.grasp_map import check_n
+
+    try:
+        return check_n(n)
+    except ValueError as exc:
+        raise _input_error("--n", exc) from None
+
+
+def _check_theta(theta: float) -> float:
+    if not math.isfinite(theta):
+        raise GraspGaitInputError(f"--theta {theta!r}: must be a finite angle in degrees, e.g. 30")
+    return float(theta)
+
+
+def _write_output(flag: str, path: str, write: Callable[[], object]) -> None:
+    """Run a writer; an unwritable path is the user's to fix (exit 2), not a crash."""
+    try:
+        write()
+    except OSError as exc:
+        raise GraspGaitInputError(
+            f"{flag} {path}: cannot write ({exc.strerror or exc}); give a writable path"
+        ) from None
+
+
+# --- map ------------------------------------------------------------------------------
+
+
+def _cmd_map(args: argparse.Namespace) -> int:
+    from graspgait_env.grasp_map import grasp_map
+    from graspgait_env.objects import load_object
+    from graspgait_env.workspace import load_hand
+
+    mu = _check_mu(args.mu)
+    n = _check_n(args.n)
+    theta = _check_theta(args.theta)
+    shape = load_object(args.object)
+    hand, max_radius = load_hand(args.hand, shape)
+    gm = grasp_map(shape, mu, n, max_radius=max_radius)
+    cells = int(gm.stable.sum())
+    print(shape.describe())
+    ws = ", ".join(f"{k + 1}: [{lo:g}, {hi:g}]" for k, (lo, hi) in enumerate(hand.workspaces_deg))
+    print(f"hand {hand.name}: workspaces (deg) {ws}; w = {hand.w_deg:g} deg")
+    print(f"grasp map n={gm.n} ({gm.step_deg:g} deg grid), mu={gm.mu:g}: "
+          f"{cells} of {gm.n * gm.n} cells stable (fraction {gm.fraction_stable():.4f})")
+    if args.npy:
+        from graspgait_env.plotting import atomic_write
+
+        _write_output("--npy", args.npy,
+                      lambda: atomic_write(args.npy, lambda fh: np.save(fh, gm.stable)))
+        print(f"wrote {args.npy}")
+    if args.png:
+        from graspgait_env.plotting import map_figure, save_figure
+
+        fig = map_figure(shape, mu, n, hand, theta, gm=gm)
+        _write_output("--png", args.png, lambda: save_figure(fig, args.png))
+        print(f"wrote {args.png}")
+    return 0
+
+
+def _add_map(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("map", help="compute and plot an object's grasp map (thesis ch. 3)",
+                       description="Compute the grasp map of OBJECT at friction MU; print a "
+                       "summary, optionally save the map (.npy) and a figure (.png): object "
+                       "with normals, grasp map, extended map with the hand's finger pair "
+                       "boxes at object angle THETA (thesis figs. 3.1, 4.5, 6.1).")
+    p.add_argument("object", metavar="OBJECT", help="bundled object name or object YAML path")
+    p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
+    p.add_argument("--n", type=int, default=180,
+                   help="contacts on the contour (default 180: 2 deg)")
+    p.add_argument("--theta", type=float, default=0.0,
+                   help="object angle (deg) at which the finger pair boxes are drawn")
+    p.add_argument("--hand", default=None,
+                   help="bundled hand name or hand YAML path (default: the thesis hand)")
+    p.add_argument("--png", metavar="FILE", help="write the figure here")
+    p.add_argument("--npy", metavar="FILE", help="write the boolean map here (np.save)")
+    p.set_defaults(func=_cmd_map)
+
+
+# --- sweep ----------------------------------------------------------------------------
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from graspgait_env.grasp_map import grasp_map
+    from graspgait_env.plotting import SWEEP_MUS, save_figure, sweep_figure, sweep_objects
+
+    n = _check_n(args.n)
+    png = args.png or f"sweep_{args.kind}.png"
+    print(f"{args.kind} sweep, n={n}: fraction of stable cells")
+    print("object    " + "".join(f"  mu={mu:<5g}" for mu in SWEEP_MUS))
+    for label, shape in sweep_objects(args.kind):
+        fr = [grasp_map(shape, mu, n).fraction_stable() for mu in SWEEP_MUS]
+        print(f"{label:<10}" + "".join(f"  {f:<8.4f}" for f in fr))
+    fig = sweep_figure(args.kind, SWEEP_MUS, n)
+    _write_output("--png", png, lambda: save_figure(fig, png))
+    print(f"wrote {png}")
+    return 0
+
+
+def _add_sweep(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("sweep", help="grasp maps over eccentricity or smoothness and friction",
+                       description="Grasp maps of ellipses of decreasing eccentricity, or of a "
+                       "circle and polygons of decreasing smoothness, for mu = .9 .. .1 "
+                       "(thesis figs. 3.8-3.11).")
+    p.add_argument("kind", choices=("eccentricity", "smoothness"))
+    p.add_argument("--n", type=int, default=180, help="contacts on the contour (default 180)")
+    p.add_argument("--png", metavar="FILE", help="figure path (default sweep_KIND.png)")
+    p.set_defaults(func=_cmd_sweep)
+
+
+# --- perf -----------------------------------------------------------------------------
+
+
+def _cmd_perf(args: argparse.Namespace) -> int:
+    from graspgait_env import perf
+
+    if args.repeat < 1:
+        raise GraspGaitInputError(f"--repeat {args.repeat}: must be >= 1, e.g. 100")
+    rows = perf.run_benchmarks(args.repeat)
+    print(perf.environment_line())
+    print()
+    print(perf.markdown_table(rows))
+    failed = [r.name for r in rows if r.passed is False]
+    print()
+    print(f"FAIL: {', '.join(failed)}" if failed else "all targets PASS")
+    if args.json:
+        _write_output("--json", args.json, lambda: perf.write_json(rows, args.json))
+        print(f"wrote {args.json}")
+    return 0  # a missed target is reported, not an error
+
+
+def _add_perf(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("perf", help="measure the performance targets",
+                       description="Time the grasp map against its targets and print a "
+                       "Markdown table (exit 0 even when a target FAILs).")
+    p.add_argument("--repeat", type=int, default=100, help="timed repeats (median; default 100)")
+    p.add_argument("--json", metavar="FILE", help="also write the rows as JSON")
+    p.set_defaults(func=_cmd_perf)
+
+
+# --- registry -------------------------------------------------------------------------
+# Later subcommands (plan, bench, simulate, train; DESIGN.md) are added HERE: write
+# `_cmd_X(args) -> int` and `_add_X(sub)` as above and append `_add_X` below. Register
+# only commands that work.
+SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
+    _add_map,
+    _add_sweep,
+    _add_perf,
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``graspgait`` argument parser with every registered subcommand."""
+    from graspgait_env import __version__
+
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="Grasp gaits for planar object manipulation (Leveroni, MIT 1997): "
+        "grasp maps, workspace maps, gaits.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for add in SUBCOMMANDS:
+        add(sub)
+    return parser
+
+
+def _error(message: str) -> None:
+    print(f"{PROG}: error: {message}", file=sys.stderr)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``graspgait`` with ``argv`` (default ``sys.argv[1:]``); return the exit status.
+
+    Bad input (:class:`~graspgait_env.errors.GraspGaitInputError`, which includes every
+    :class:`~graspgait_env.errors.ConfigError`) prints one line and returns 2; a
+    :class:`~graspgait_env.errors.NoGaitError` prints one line and returns 1. Usage
+    errors (and ``--help``) print as argparse does; their exit status is returned
+    rather than raised, so in-process callers always get an int.
+    """
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    try:
+        return int(args.func(args))
+    except GraspGaitInputError as exc:
+        _error(str(exc))
+        return 2
+    except NoGaitError as exc:
+        _error(str(exc))
+        return 1
+    except KeyboardInterrupt:
+        _error("interrupted")
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

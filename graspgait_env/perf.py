@@ -1,0 +1,170 @@
+"""Performance targets, measured in one process (``graspgait perf``).
+
+Each benchmark is a function ``bench(repeat) -> list[BenchRow]`` registered in
+:data:`BENCHMARKS` with :func:`register`; :func:`run_benchmarks` runs them all in order
+and :func:`markdown_table` prints the rows. A row with a target says PASS or FAIL; a
+row without one (``passed is None``) is context (e.g. the reference loop's time).
+
+Later work adds rows by writing one more function in its own module and decorating it
+with ``@register`` (the module must be imported before :func:`run_benchmarks`; list
+it in :data:`BENCHMARK_MODULES`).
+
+Timing: :func:`time.perf_counter`, a warm-up call first, the median over repeats.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "BenchRow",
+    "BENCHMARKS",
+    "BENCHMARK_MODULES",
+    "register",
+    "median_time_s",
+    "run_benchmarks",
+    "markdown_table",
+    "write_json",
+    "GRASP_MAP_TARGET_MS",
+    "SPEEDUP_TARGET",
+]
+
+GRASP_MAP_TARGET_MS = 2.0  # (ms) a 180 x 180 grasp map of the thesis ellipse
+SPEEDUP_TARGET = 10.0  # vectorized grasp map vs the per-pair Python loop
+
+
+@dataclass
+class BenchRow:
+    """One line of the performance table.
+
+    Attributes
+    ----------
+    name
+        What was measured, e.g. ``"grasp map 180x180"``.
+    value
+        The measurement, in ``unit``.
+    unit
+        ``"ms"``, ``"x"`` (a ratio), ...
+    target
+        The target as text (``"< 2 ms"``), or ``""`` for a context row.
+    passed
+        True / False against the target; None for a context row.
+    detail
+        Free text: object, repeats, ...
+    """
+
+    name: str
+    value: float
+    unit: str
+    target: str = ""
+    passed: bool | None = None
+    detail: str = ""
+
+    @property
+    def verdict(self) -> str:
+        """``PASS``, ``FAIL`` or ``-``."""
+        return "-" if self.passed is None else ("PASS" if self.passed else "FAIL")
+
+
+Benchmark = Callable[[int], list[BenchRow]]
+BENCHMARKS: list[Benchmark] = []
+# Modules whose import registers more benchmarks (later issues append theirs here).
+BENCHMARK_MODULES: list[str] = []
+
+
+def register(fn: Benchmark) -> Benchmark:
+    """Decorator: add a benchmark ``fn(repeat) -> list[BenchRow]`` to the table."""
+    if fn not in BENCHMARKS:
+        BENCHMARKS.append(fn)
+    return fn
+
+
+def median_time_s(fn: Callable[[], Any], repeat: int, warmup: int = 1) -> float:
+    """Median wall time (s) of ``fn()`` over ``repeat`` calls after ``warmup`` calls."""
+    if repeat < 1:
+        raise ValueError(f"repeat={repeat!r}: must be >= 1")
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+@register
+def bench_grasp_map(repeat: int) -> list[BenchRow]:
+    """Vectorized grasp map vs the per-pair loop: thesis ellipse, n = 180, mu = 0.7."""
+    from graspgait_env.grasp_map import grasp_map, grasp_map_loop
+    from graspgait_env.objects import load_object
+
+    shape = load_object("ellipse")
+    mu, n = 0.7, 180
+    t_vec = median_time_s(lambda: grasp_map(shape, mu, n), repeat, warmup=3)
+    loop_repeat = max(1, min(5, repeat))  # the loop is slow: a few runs suffice
+    t_loop = median_time_s(lambda: grasp_map_loop(shape, mu, n), loop_repeat, warmup=1)
+    ratio = t_loop / t_vec
+    what = f"{shape.name}, mu={mu:g}"
+    return [
+        BenchRow(f"grasp map {n}x{n}", 1e3 * t_vec, "ms", f"< {GRASP_MAP_TARGET_MS:g} ms",
+                 1e3 * t_vec < GRASP_MAP_TARGET_MS, f"{what}, median of {repeat}"),
+        BenchRow(f"grasp map {n}x{n}, per-pair loop", 1e3 * t_loop, "ms", "", None,
+                 f"{what}, median of {loop_repeat}"),
+        BenchRow("speed-up vs loop", ratio, "x", f">= {SPEEDUP_TARGET:g}x",
+                 ratio >= SPEEDUP_TARGET, "loop time / vectorized time"),
+    ]
+
+
+def run_benchmarks(repeat: int = 100) -> list[BenchRow]:
+    """Import :data:`BENCHMARK_MODULES`, then run every registered benchmark in order."""
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
+        raise ValueError(f"repeat={repeat!r}: must be an integer >= 1, e.g. 100")
+    for mod in BENCHMARK_MODULES:
+        importlib.import_module(mod)
+    rows: list[BenchRow] = []
+    for bench in BENCHMARKS:
+        rows.extend(bench(repeat))
+    return rows
+
+
+def _fmt(value: float) -> str:
+    return f"{value:.3g}" if abs(value) < 100 else f"{value:.0f}"
+
+
+def markdown_table(rows: list[BenchRow]) -> str:
+    """The rows as a Markdown table: benchmark, value, target, result, detail."""
+    lines = ["| benchmark | value | target | result | detail |",
+             "|---|---:|---|---|---|"]
+    for r in rows:
+        unit = "x" if r.unit == "x" else f" {r.unit}"
+        lines.append(f"| {r.name} | {_fmt(r.value)}{unit} | {r.target or '-'} | "
+                     f"{r.verdict} | {r.detail} |")
+    return "\n".join(lines)
+
+
+def environment_line() -> str:
+    """Python, NumPy and machine, for the record beside the table."""
+    return (f"Python {platform.python_version()}, NumPy {np.__version__}, "
+            f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs")
+
+
+def write_json(rows: list[BenchRow], path: str | os.PathLike[str]) -> Path:
+    """Write the rows (with their verdicts) to ``path`` as JSON, atomically."""
+    from graspgait_env.plotting import atomic_write
+
+    doc = {"environment": environment_line(),
+           "rows": [{**asdict(r), "verdict": r.verdict} for r in rows]}
+    text = json.dumps(doc, indent=2) + "\n"
+    return atomic_write(path, lambda fh: fh.write(text.encode("utf-8")))
