@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from graspgait_env.force_closure import check_mu, force_closure_nguyen, force_closure_wrench
+from graspgait_env.force_closure import check_mu, force_closure_wrench
 from graspgait_env.shapes import Shape
 
 __all__ = ["GraspMap", "grasp_map", "grasp_map_loop", "grid_angles_deg", "check_n"]

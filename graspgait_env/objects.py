@@ -62,7 +62,8 @@ def read_yaml_mapping(path: Path, what: str) -> dict[str, Any]:
     except FileNotFoundError:
         raise ConfigError(src, "", "file not found", f"give an existing {what} YAML path") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(src, "", f"cannot read file ({exc})", "give a readable UTF-8 file") from None
+        raise ConfigError(src, "", f"cannot read file ({exc})",
+                          "give a readable UTF-8 file") from None
     if not text.strip():
         raise ConfigError(src, "", "the file is empty", f"write a {what} mapping into it")
     try:

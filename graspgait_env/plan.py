@@ -31,14 +31,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.force_closure import force_closure_nguyen
 from graspgait_env.gait import GaitModel, GaitState
@@ -52,25 +51,9 @@ __all__ = [
     "InvalidPlanError",
     "validate_plan",
     "plan_from_states",
-    "write_atomic",
 ]
 
 _TOL_DEG = 1e-6  # (degrees) slack on workspace edges when replaying a plan
-
-
-def write_atomic(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (temp file in the same folder, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 @dataclass
@@ -95,7 +78,7 @@ class Plan:
 
     def save(self, path: str | Path) -> None:
         """Write the JSON atomically."""
-        write_atomic(path, self.to_json() + "\n")
+        write_text_atomic(path, self.to_json() + "\n")
 
     @classmethod
     def from_dict(cls, d: Any, source: str = "<plan>") -> Plan:
@@ -231,7 +214,8 @@ def validate_plan(plan: Plan, shape: Shape | str | None = None, hand: Hand | Non
             if math.isnan(_in_arc(a, hand.workspaces_deg[fi - 1])):
                 return bad(i, "outside-workspace",
                            f"finger {fi} at phi={phi:g} deg lies at F angle {a:g} deg at "
-                           f"theta={theta:g}, outside its workspace {list(hand.workspaces_deg[fi - 1])}")
+                           f"theta={theta:g}, outside its workspace "
+                           f"{list(hand.workspaces_deg[fi - 1])}")
             out[fi] = float(phi)
         (f1, p1), (f2, p2) = sorted(out.items())
         phis = np.array([p1, p2])

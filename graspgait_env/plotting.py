@@ -21,10 +21,8 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
-from typing import BinaryIO
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -33,6 +31,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
+from graspgait_env.atomic import atomic_write
 from graspgait_env.grasp_map import GraspMap, grasp_map
 from graspgait_env.shapes import Circle, Ellipse, Polygon, Shape
 from graspgait_env.workspace import FingerPairBox, Hand
@@ -443,42 +442,6 @@ def sweep_figure(kind: str, mus: Sequence[float] = SWEEP_MUS, n: int = 180) -> F
     fig.suptitle(f"Grasp maps: {what} decreasing down the rows, friction decreasing to the "
                  f"right (n={n}; % = stable fraction)")
     return fig
-
-
-def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], object]) -> Path:
-    """Write a file atomically: ``write(fh)`` into a temporary file, then rename.
-
-    The temporary file lives in the target's directory (created if missing), so
-    :func:`os.replace` is atomic: a reader sees the old file or the whole new one,
-    never a partial write. On any error the temporary file is removed.
-
-    Parameters
-    ----------
-    path
-        Target file.
-    write
-        Called with the open binary file handle.
-
-    Returns
-    -------
-    Path
-        The path written.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; outputs are for reading
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    return path
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str], *, dpi: int = 110) -> Path:
