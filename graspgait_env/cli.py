@@ -4,6 +4,10 @@
 
     graspgait map OBJECT --mu 0.7 [--n 180] [--theta 0] [--hand thesis] [--png F] [--npy F]
     graspgait sweep eccentricity|smoothness [--n 180] [--png F]
+    graspgait plan OBJECT --mu 0.7 --planner P [--start PHI1,PHI2] [--turn 360] [--json F]
+                   [--motion F] [--png F]
+    graspgait bench [--objects ...] [--mus 0.8,0.7] [--planners ...] [--starts 10]
+                    [--csv F] [--json F] [--md F]
     graspgait perf [--repeat 100] [--json F]
 
 Exit status: 0 on success; 2 on bad input (an argument, a file, a field), with one
@@ -184,6 +188,175 @@ def _add_perf(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_perf)
 
 
+# --- plan -----------------------------------------------------------------------------
+
+
+def _parse_start(text: str | None, model) -> object:
+    """``PHI1,PHI2`` (object-frame degrees at theta = 0) to a start state; fingers follow
+    from the workspaces each contact lies in."""
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        phis = [float(p) for p in parts]
+    except ValueError:
+        phis = []
+    if len(phis) != 2 or not all(math.isfinite(p) for p in phis):
+        raise GraspGaitInputError(f"--start {text!r}: give two contact angles in degrees, "
+                                  "e.g. --start 50,270")
+    fingers = model.hand.finger_at(phis)
+    for phi, f in zip(phis, fingers, strict=True):
+        if f == 0:
+            raise GraspGaitInputError(f"--start: contact {phi:g} deg lies in no finger's "
+                                      f"workspace {list(model.hand.workspaces_deg)}; move it")
+    if fingers[0] == fingers[1]:
+        raise GraspGaitInputError(f"--start {text}: both contacts lie in finger "
+                                  f"{int(fingers[0])}'s workspace; use two fingers")
+    return model.start_state({int(f): phi for f, phi in zip(fingers, phis, strict=True)})
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    from baselines.registry import get_planner, run_planner
+    from graspgait_env.gait import GaitModel
+    from graspgait_env.plan import InvalidPlanError, validate_plan
+
+    mu = _check_mu(args.mu)
+    n = _check_n(args.n)
+    if not math.isfinite(args.turn) or args.turn == 0:
+        raise GraspGaitInputError(f"--turn {args.turn!r}: give a non-zero finite angle in "
+                                  "degrees (positive counter-clockwise), e.g. 360")
+    get_planner(args.planner)  # refuse unknown names before any work
+    model = GaitModel(args.object, mu, hand=args.hand, n=n)
+    start = _parse_start(args.start, model)
+    res = run_planner(args.planner, model, start, args.turn)
+    print(model.shape.describe())
+    print(f"planner {res.planner}: nodes opened {res.nodes_opened}, created "
+          f"{res.nodes_created}, wall time {res.wall_time_s * 1000:.1f} ms")
+    if res.plan is None:
+        from baselines.rule_based import diagnose_no_gait
+
+        why = res.reason or "no gait found"
+        raise NoGaitError(f"{why}; diagnosis: {diagnose_no_gait(model, start)}")
+    v = validate_plan(res.plan, model.shape, model.hand, args.turn, model.max_radius)
+    if v is not None:  # a planner bug, never the user's input
+        raise RuntimeError(f"planner {args.planner} returned an invalid plan: "
+                           f"{InvalidPlanError(v)}")
+    res.plan.stats.update({"planner": res.planner, "nodes_opened": res.nodes_opened,
+                           "regrasps": res.regrasps, "rotation_deg": res.rotation_deg,
+                           "path_length": res.path_length})
+    if res.pattern:
+        res.plan.stats["pattern"] = res.pattern
+    print(f"gait: {res.regrasps} regrasps, path length {res.path_length}, rotation "
+          f"{res.rotation_deg:g} deg" + (f", pattern {res.pattern}" if res.pattern else ""))
+    print(f"start {res.plan.steps[0]['contacts']}; plan passes the validator")
+    if args.json:
+        _write_output("--json", args.json, lambda: res.plan.save(args.json))
+        print(f"wrote {args.json}")
+    if args.motion:
+        from graspgait_env.atomic import write_text_atomic
+
+        _write_output("--motion", args.motion,
+                      lambda: write_text_atomic(args.motion, res.plan.to_motion_file()))
+        print(f"wrote {args.motion}")
+    if args.png:
+        from graspgait_env.plotting import gait_figure, save_figure
+
+        fig = gait_figure(model.grasp_map, model.hand, res.plan.steps,
+                          title=f"{model.shape.name}, mu={mu:g}: {res.planner} gait, "
+                          f"{res.regrasps} regrasps, {res.rotation_deg:g} deg")
+        _write_output("--png", args.png, lambda: save_figure(fig, args.png))
+        print(f"wrote {args.png}")
+    return 0
+
+
+def _add_plan(sub: argparse._SubParsersAction) -> None:
+    from baselines.registry import PLANNERS
+
+    p = sub.add_parser("plan", help="plan a grasp gait (thesis ch. 5-6)",
+                       description="Plan a gait turning OBJECT by TURN degrees with one of "
+                       "the thesis's planners or the exact optimum; exit 0 with a plan, 1 "
+                       "when no gait exists (with a diagnosis), 2 for bad input.")
+    p.add_argument("object", metavar="OBJECT", help="bundled object name or object YAML path")
+    p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
+    p.add_argument("--planner", required=True, choices=list(PLANNERS), metavar="P",
+                   help=f"one of: {', '.join(PLANNERS)}")
+    p.add_argument("--start", metavar="PHI1,PHI2",
+                   help="initial grasp: two object-frame contact angles (deg) at theta = 0; "
+                   "default: the planner's choice (rule-based) or the first of a spread of "
+                   "legal grasps from which a gait exists")
+    p.add_argument("--turn", type=float, default=360.0,
+                   help="turn in degrees, counter-clockwise positive (default 360)")
+    p.add_argument("--n", type=int, default=180, help="grid: contacts and rotation steps "
+                   "of 360/n deg (default 180)")
+    p.add_argument("--hand", default=None, help="bundled hand name or hand YAML path")
+    p.add_argument("--json", metavar="FILE", help="write the plan JSON (DESIGN.md)")
+    p.add_argument("--motion", metavar="FILE", help="write the thesis's motion_file (7.4.1)")
+    p.add_argument("--png", metavar="FILE", help="draw the gait over the maps")
+    p.set_defaults(func=_cmd_plan)
+
+
+# --- bench ----------------------------------------------------------------------------
+
+
+def _csv_list(flag: str, text: str, conv):
+    try:
+        vals = [conv(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        vals = []
+    if not vals:
+        raise GraspGaitInputError(f"{flag} {text!r}: give a comma-separated list")
+    return vals
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from baselines import bench
+    from baselines.registry import get_planner
+
+    mus = [_check_mu(m) for m in _csv_list("--mus", args.mus, float)]
+    planners = _csv_list("--planners", args.planners, str)
+    for p in planners:
+        get_planner(p)
+    objects = _csv_list("--objects", args.objects, str)
+    if args.starts < 1:
+        raise GraspGaitInputError(f"--starts {args.starts}: must be >= 1, e.g. 10")
+    from graspgait_env.objects import load_object
+
+    for o in objects:
+        load_object(o)  # refuse bad names before the long run
+    cases = bench.run_bench(objects, mus, planners, args.starts)
+    report = bench.markdown_report(cases)
+    print(report)
+    if args.csv:
+        _write_output("--csv", args.csv, lambda: bench.write_csv(cases, args.csv))
+        print(f"wrote {args.csv}")
+    if args.json:
+        _write_output("--json", args.json, lambda: bench.write_json(cases, args.json))
+        print(f"wrote {args.json}")
+    if args.md:
+        from graspgait_env.atomic import write_text_atomic
+
+        _write_output("--md", args.md, lambda: write_text_atomic(args.md, report + "\n"))
+        print(f"wrote {args.md}")
+    return 0
+
+
+def _add_bench(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="regenerate the thesis's Tables 1 and 6.1",
+                       description="Run the planners on the thesis's four objects (fig. 5.3), "
+                       "10 initial grasps each, mu 0.8 and 0.7, 90-degree workspaces; print "
+                       "Tables 1 and 6.1 in Markdown beside the thesis's figures.")
+    p.add_argument("--objects", default="circle,ellipse,pentagon,hexagon",
+                   help="comma-separated objects (default the thesis's four)")
+    p.add_argument("--mus", default="0.8,0.7", help="comma-separated friction coefficients")
+    p.add_argument("--planners", default="best-first,rule,optimal",
+                   help="comma-separated planner names")
+    p.add_argument("--starts", type=int, default=10, help="initial grasps per object and mu")
+    p.add_argument("--csv", metavar="FILE", help="write one row per run")
+    p.add_argument("--json", metavar="FILE", help="write runs and summary")
+    p.add_argument("--md", metavar="FILE", help="write the Markdown tables")
+    p.set_defaults(func=_cmd_bench)
+
+
 # --- registry -------------------------------------------------------------------------
 # Later subcommands (plan, bench, simulate, train; DESIGN.md) are added HERE: write
 # `_cmd_X(args) -> int` and `_add_X(sub)` as above and append `_add_X` below. Register
@@ -191,6 +364,8 @@ def _add_perf(sub: argparse._SubParsersAction) -> None:
 SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_map,
     _add_sweep,
+    _add_plan,
+    _add_bench,
     _add_perf,
 ]
 

@@ -80,7 +80,7 @@ class BenchRow:
 Benchmark = Callable[[int], list[BenchRow]]
 BENCHMARKS: list[Benchmark] = []
 # Modules whose import registers more benchmarks (later issues append theirs here).
-BENCHMARK_MODULES: list[str] = []
+BENCHMARK_MODULES: list[str] = ["baselines.bench"]
 
 
 def register(fn: Benchmark) -> Benchmark:

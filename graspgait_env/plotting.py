@@ -46,6 +46,8 @@ __all__ = [
     "sweep_figure",
     "save_figure",
     "atomic_write",
+    "gait_path",
+    "gait_figure",
     "SWEEP_MUS",
     "BOX_COLORS",
 ]
@@ -456,3 +458,100 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], *, dpi: int = 110) ->
     """
     fmt = Path(path).suffix[1:].lower() or "png"
     return atomic_write(path, lambda fh: fig.savefig(fh, format=fmt, dpi=dpi))
+
+
+def gait_path(plan_steps: Sequence[dict]) -> list[dict]:
+    """Replay a plan's steps into the points a gait figure draws (thesis figs. 4.6–4.8, 6.10).
+
+    The two held contacts are put on the axes (the lower-numbered finger of the first
+    grasp on x); at a regrasp the new contact takes the axis of the lifted one, unwrapped
+    to within 180° of it, so the path is continuous in the extended map.
+
+    Returns
+    -------
+    list of dict
+        One entry per state: ``op`` (grasp/rotate/regrasp), ``obj`` = (x, y) unwrapped
+        object-frame contacts (deg), ``ws`` = (x, y) unwrapped workspace-frame angles
+        (contacts plus θ), ``fingers`` = (finger on x, finger on y), ``theta`` (deg).
+    """
+    first = plan_steps[0]["contacts"]
+    (fx, px), (fy, py) = sorted((int(f), float(v)) for f, v in first.items())
+    theta = 0.0
+    pts = [{"op": "grasp", "obj": (px, py), "fingers": (fx, fy), "theta": theta}]
+    for st in plan_steps[1:]:
+        if st["op"] == "rotate":
+            theta += float(st["delta"])
+            pts.append({**pts[-1], "op": "rotate", "theta": theta})
+            continue
+        new = {int(f): float(v) for f, v in st["contacts"].items()}
+        (x, y), (fx, fy) = pts[-1]["obj"], pts[-1]["fingers"]
+        if fx in new:  # x kept: the new finger takes y
+            (h,) = set(new) - {fx}
+            y = y + ((new[h] - y + 180.0) % 360.0 - 180.0)
+            fy = h
+        else:
+            (h,) = set(new) - {fy}
+            x = x + ((new[h] - x + 180.0) % 360.0 - 180.0)
+            fx = h
+        pts.append({"op": "regrasp", "obj": (x, y), "fingers": (fx, fy), "theta": theta})
+    for p in pts:
+        p["ws"] = (p["obj"][0] + p["theta"], p["obj"][1] + p["theta"])
+    return pts
+
+
+def gait_figure(gm: GraspMap, hand: Hand, plan_steps: Sequence[dict],
+                title: str = "") -> Figure:
+    """A gait drawn two ways (thesis figs. 4.6–4.8, 6.10).
+
+    Left, the **workspace frame**: the finger pair boxes of the extended workspace map
+    stand still; rotations are diagonal segments (both workspace angles grow by the
+    same amount), regrasps horizontal or vertical moves into another box. Right, the
+    **object frame**: the extended grasp map with the sequence of grasps; rotations
+    leave the grasp point in place (the boxes slide instead, fig. 4.5) and regrasps are
+    horizontal or vertical moves, giving the staircase or plus patterns of fig. 6.10.
+    Grasp points are numbered in order.
+    """
+    pts = gait_path(plan_steps)
+    fig = Figure(figsize=(13, 6.4), layout="constrained")
+    axes = fig.subplots(1, 2)
+    for ax, key in zip(axes, ("ws", "obj"), strict=True):
+        xy = np.array([p[key] for p in pts])
+        lo = np.floor((xy.min() - 100.0) / 90.0) * 90.0
+        hi = np.ceil((xy.max() + 100.0) / 90.0) * 90.0
+        if key == "obj":
+            # tile the grasp map over [lo, hi]^2 (cell k centred on k * step)
+            n, step = gm.n, gm.step_deg
+            idx = np.arange(int(np.floor(lo / step)), int(np.ceil(hi / step)) + 1)
+            tile = gm.stable[np.ix_(idx % n, idx % n)]
+            ax.imshow(tile.T, origin="lower", cmap=_STABLE_CMAP, vmin=0, vmax=1,
+                      interpolation="nearest",
+                      extent=[idx[0] * step - step / 2, idx[-1] * step + step / 2,
+                              idx[0] * step - step / 2, idx[-1] * step + step / 2])
+            ax.set_title("object frame: extended grasp map and grasps")
+        else:
+            reps = range(int(np.floor(lo / 360.0)) - 1, int(np.ceil(hi / 360.0)) + 1)
+            for box in hand.finger_pair_boxes:
+                (xl, xh), (yl, yh) = box.x_deg, box.y_deg
+                for a in reps:
+                    for b in reps:
+                        ax.add_patch(Rectangle((xl + 360.0 * a, yl + 360.0 * b), xh - xl,
+                                               yh - yl, fill=False,
+                                               edgecolor=BOX_COLORS.get(box.kind, "k"),
+                                               lw=1.0))
+            ax.set_title("workspace frame: finger pair boxes, rotations diagonal")
+        ax.plot(xy[:, 0], xy[:, 1], "-", color="tab:orange", lw=1.6, zorder=3)
+        grasps = [i for i, p in enumerate(pts) if p["op"] != "rotate"]
+        ax.plot(xy[grasps, 0], xy[grasps, 1], "o", color="tab:orange", ms=4, zorder=4)
+        ax.plot(*xy[0], "s", color="tab:green", ms=8, zorder=5, label="start")
+        ax.plot(*xy[-1], "*", color="tab:red", ms=12, zorder=5, label="end")
+        for num, i in enumerate(grasps):
+            ax.annotate(str(num), xy[i], textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.set_xlim(lo, hi)
+        ax.set_ylim(lo, hi)
+        ax.set_aspect("equal")
+        what = "object-frame contact" if key == "obj" else "workspace-frame angle"
+        ax.set_xlabel(f"x finger: {what} (deg)")
+        ax.set_ylabel(f"y finger: {what} (deg)")
+        ax.legend(loc="upper left", fontsize=7)
+    fig.suptitle(title)
+    return fig
