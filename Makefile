@@ -20,6 +20,8 @@ demo: $(STAMP)
 	$(BIN)/graspgait map ellipse --mu 0.7 --theta 30 --png out/ellipse_map.png --npy out/ellipse_map.npy
 	$(BIN)/graspgait map pentagon --mu 0.7 --png out/pentagon_map.png
 	$(BIN)/graspgait sweep eccentricity --png out/sweep_eccentricity.png
+	$(BIN)/graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270 \
+		--json out/pentagon_plan.json --motion out/pentagon_motion.txt --png out/pentagon_gait.png
 	$(BIN)/graspgait perf
 	@echo "demo figures written to out/"
 
