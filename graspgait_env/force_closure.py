@@ -13,11 +13,16 @@ Two independent tests, vectorized over any number of contact pairs:
   is two-sided, so we test ``|c3| < mu c1`` — a choice, tested in
   ``tests/test_force_closure.py``. Strict inequalities: a grasp exactly on the cone
   boundary is not force-closure.
-- :func:`force_closure_nguyen` — Nguyen's geometric test: the segment joining the
-  contacts lies strictly inside both friction cones (half-angle ``atan(mu)``).
+- :func:`force_closure_nguyen` — Nguyen's geometric test: the line joining the
+  contacts lies strictly inside both friction cones (half-angle ``atan(mu)``), with
+  the fingers either squeezing (``d = p2 - p1`` inside the cone at ``p1`` and ``-d``
+  inside the cone at ``p2``) or pushing apart (the reverse: two fingers in a notch of
+  a non-convex object pressing its walls outward). Both are force-closure; the wrench
+  test finds both, and so must this one. On a convex object only squeezing occurs.
 
-Both are mathematically the same set; numerically they can differ only within
-rounding of the cone boundary, which :func:`cone_margin_deg` measures.
+Both are mathematically the same set (squeezing and pushing-apart grasps alike);
+numerically they can differ only within rounding of the cone boundary, which
+:func:`cone_margin_deg` measures.
 
 Conventions: points and inward unit normals in any common frame (metres), trailing
 axis (x, y). ``mu`` is the Coulomb coefficient (dimensionless, > 0).
@@ -72,7 +77,10 @@ def force_closure_nguyen(
     """
     cos_a = math.cos(math.atan(check_mu(mu)))
     dist, c1, c2 = _pair_geometry(p1, n1, p2, n2)
-    return (c1 > cos_a * dist) & (c2 > cos_a * dist) & (dist > 0)
+    lim = cos_a * dist
+    squeeze = (c1 > lim) & (c2 > lim)
+    expand = (-c1 > lim) & (-c2 > lim)
+    return (squeeze | expand) & (dist > 0)
 
 
 def cone_margin_deg(
@@ -80,15 +88,19 @@ def cone_margin_deg(
 ) -> NDArray[np.float64]:
     """Signed distance (degrees) of the grasp from the friction-cone boundary.
 
-    ``atan(mu) - max(angle(d, n1), angle(-d, n2))`` with ``d = p2 - p1``: positive
-    inside both cones (force-closure), negative outside, zero on the boundary.
+    ``atan(mu) - max(angle(d, n1), angle(-d, n2))`` with ``d = p2 - p1`` for a
+    squeezing grasp, the same with ``-d`` for fingers pushing apart; the larger of the
+    two. Positive inside both cones (force-closure), negative outside, zero on the
+    boundary.
     """
     alpha = math.atan(check_mu(mu))
     dist, c1, c2 = _pair_geometry(p1, n1, p2, n2)
     with np.errstate(invalid="ignore", divide="ignore"):
         a1 = np.arccos(np.clip(c1 / dist, -1.0, 1.0))
         a2 = np.arccos(np.clip(c2 / dist, -1.0, 1.0))
-    return np.rad2deg(alpha - np.maximum(a1, a2))
+    squeeze = np.maximum(a1, a2)
+    expand = np.maximum(np.pi - a1, np.pi - a2)
+    return np.rad2deg(alpha - np.minimum(squeeze, expand))
 
 
 def force_closure_wrench(

@@ -155,8 +155,14 @@ def grasp_map(
     --------
     >>> from graspgait_env.shapes import Circle
     >>> gm = grasp_map(Circle(0.05), mu=0.3, n=12)
-    >>> bool(gm.stable[0, 6]), bool(gm.stable[0, 5]), bool(gm.stable[0, 0])
-    (True, False, False)
+    >>> bool(gm.stable[0, 6]), bool(gm.stable[0, 5]), bool(gm.stable[0, 4])
+    (True, True, False)
+
+    Contacts 150° apart see the chord 15° off each normal, inside the 16.7° cone of
+    mu = 0.3; 120° apart, 30° off: outside. The diagonal is never stable:
+
+    >>> bool(gm.stable[3, 3])
+    False
     """
     if not isinstance(shape, Shape):
         from graspgait_env.objects import load_object
@@ -180,7 +186,8 @@ def grasp_map(
         lim = np.sqrt(np.maximum(sq[:, None] + sq[None, :] - 2.0 * G, 0.0))
         lim *= cos_a
         A = M - h[:, None]
-        stable = (A > lim) & (A.T > lim)
+        # squeezing (both dot products positive) or pushing apart in a notch (both negative)
+        stable = ((A > lim) & (A.T > lim)) | ((A < -lim) & (A.T < -lim))
     elif method == "wrench":
         I, J = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
         stable = force_closure_wrench(P[I], N[I], P[J], N[J], mu)
@@ -213,9 +220,8 @@ def grasp_map_loop(shape: Shape, mu: float, n: int = 180) -> GraspMap:
             if j == i or not usable[j]:
                 continue
             dx, dy = P[j][0] - xi, P[j][1] - yi
-            dist = math.hypot(dx, dy)
-            stable[i, j] = (
-                dx * nxi + dy * nyi > cos_a * dist
-                and -(dx * N[j][0] + dy * N[j][1]) > cos_a * dist
-            )
+            lim = cos_a * math.hypot(dx, dy)
+            c1 = dx * nxi + dy * nyi
+            c2 = -(dx * N[j][0] + dy * N[j][1])
+            stable[i, j] = (c1 > lim and c2 > lim) or (c1 < -lim and c2 < -lim)
     return _make(stable, phi, mu, shape.name, usable)

@@ -85,8 +85,12 @@ def positive_length(src: str, field: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(src, field, f"expected a number (metres), got {value!r}",
                           f"set {field} to a positive length in metres")
-    if not math.isfinite(value):
-        raise ConfigError(src, field, f"{value!r} is not finite",
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer too large for a float
+        finite = False
+    if not finite:
+        raise ConfigError(src, field, f"{str(value)[:20]} is not finite",
                           f"set {field} to a finite positive length in metres")
     if value <= 0:
         raise ConfigError(src, field, f"{value!r} is not > 0",
@@ -107,8 +111,12 @@ def _vertices(src: str, value: Any) -> list[list[float]]:
         for c in pt:
             if isinstance(c, bool) or not isinstance(c, (int, float)):
                 raise ConfigError(src, f, f"coordinate {c!r} is not a number", fix)
-            if not math.isfinite(c):
-                raise ConfigError(src, f, f"coordinate {c!r} is not finite", fix)
+            try:
+                finite = math.isfinite(c)
+            except OverflowError:  # an integer too large for a float
+                finite = False
+            if not finite:
+                raise ConfigError(src, f, f"coordinate {str(c)[:20]} is not finite", fix)
             xy.append(float(c))
         out.append(xy)
     if len(out) < 3:
@@ -137,7 +145,7 @@ def object_from_dict(data: dict[str, Any], source: str = "<dict>") -> tuple[Shap
         raise ConfigError(src, "name", f"expected a non-empty string, got {name!r}",
                           "give the object a name")
     kind = data["type"]
-    if kind not in _TYPE_FIELDS:
+    if not isinstance(kind, str) or kind not in _TYPE_FIELDS:
         raise ConfigError(src, "type", f"unknown type {kind!r}",
                           f"use one of {', '.join(_TYPE_FIELDS)}")
     allowed = {"name", "type", *_TYPE_FIELDS[kind], *OBJECT_DEFAULTS}

@@ -353,6 +353,9 @@ def load_hand(name_or_path: str | Path | Hand | None = None,
                           "give the largest usable radius in metres, or drop the key")
     try:
         hand = effective_hand(fingers, shape, max_radius, str(name))
+    except ConfigError as exc:  # the effective arcs overlap: say so once, about this file
+        raise ConfigError(src, "reach", f"the effective workspaces {exc.problem}",
+                          exc.fix) from None
     except ValueError as exc:
         raise ConfigError(src, "reach", str(exc).split("; ")[0],
                           str(exc).split("; ")[-1]) from None
