@@ -25,6 +25,13 @@ from graspgait_env.workspace import (
 
 __version__ = "0.1.0"
 
+# `import graspgait_env` registers every Gymnasium id (GraspGait-v0, GraspGaitRandom-v0);
+# registration is skipped when gymnasium is not installed, so the map-level core keeps
+# working without it.
+from graspgait_env.envs.registration import register_envs as _register_envs  # noqa: E402
+
+_register_envs()
+
 __all__ = [
     "Circle",
     "CircularReach",

@@ -140,6 +140,11 @@ class GaitModel:
         self.P = int(self.ws_width.max())
         self.n_actions = 2 * self.R + 2 * self.P
         self._positions = np.arange(self.P)
+        # hot-path caches for action_mask: Python ints, and the extended map transposed so
+        # that "contact c against every contact from i0 on" is one contiguous row slice
+        self._starts = [int(x) for x in self.ws_start]
+        self._widths = [int(x) for x in self.ws_width]
+        self._rows = np.ascontiguousarray(self.grasp_map.extended().T)
 
     # ----------------------------------------------------------------- geometry
     def position(self, finger: int, contact: int, k: int) -> int:
@@ -218,22 +223,32 @@ class GaitModel:
     def action_mask(self, s: GaitState) -> NDArray[np.bool_]:
         """Exactly the legal actions of state ``s`` (thesis 5.2 branching), vectorized.
 
-        Every planner and both environments use this one function.
+        Every planner and both environments use this one function. Rotations: both
+        contacts stay in their workspaces all the way (the room left on the tighter
+        side, each way). Regrasps: the free finger ``h`` at every grid angle of its
+        workspace, i.e. object contacts ``(s_h + p - k) mod n`` for ``p = 0 .. W_h - 1``,
+        against the kept contact — two contiguous row slices of the (transposed,
+        2 × 2-tiled) grasp map written into the interleaved regrasp block.
         """
         mask = np.zeros(self.n_actions, dtype=bool)
-        f, g = s.held()
+        c = s.contacts
+        f, g = [i for i in range(3) if c[i] >= 0]
         h = 3 - f - g
-        pf = self.position(f, s.contacts[f], s.k)
-        pg = self.position(g, s.contacts[g], s.k)
-        ccw = min(self.ws_width[f] - 1 - pf, self.ws_width[g] - 1 - pg)
+        n, k = self.n, s.k
+        st, wd = self._starts, self._widths
+        pf = (c[f] + k - st[f]) % n
+        pg = (c[g] + k - st[g]) % n
+        ccw = min(wd[f] - 1 - pf, wd[g] - 1 - pg)
         cw = min(pf, pg)
-        mask[:ccw] = True
-        mask[self.R : self.R + cw] = True
-        W = int(self.ws_width[h])
-        cand = (self.ws_start[h] + self._positions[:W] - s.k) % self.n
-        reg = mask[2 * self.R :].reshape(self.P, 2)
-        reg[:W, 0] = self.stable[cand, s.contacts[g]]  # lift f (lower number), keep g
-        reg[:W, 1] = self.stable[cand, s.contacts[f]]  # lift g (higher number), keep f
+        if ccw > 0:
+            mask[:ccw] = True
+        if cw > 0:
+            mask[self.R : self.R + cw] = True
+        W = wd[h]
+        i0 = (st[h] - k) % n
+        b = 2 * self.R
+        mask[b : b + 2 * W : 2] = self._rows[c[g], i0 : i0 + W]  # lift f (lower), keep g
+        mask[b + 1 : b + 2 * W : 2] = self._rows[c[f], i0 : i0 + W]  # lift g, keep f
         return mask
 
     def decode(self, s: GaitState, action: int) -> Move:

@@ -80,7 +80,7 @@ class BenchRow:
 Benchmark = Callable[[int], list[BenchRow]]
 BENCHMARKS: list[Benchmark] = []
 # Modules whose import registers more benchmarks (later issues append theirs here).
-BENCHMARK_MODULES: list[str] = ["baselines.bench"]
+BENCHMARK_MODULES: list[str] = ["baselines.bench", "graspgait_env.envs.bench"]
 
 
 def register(fn: Benchmark) -> Benchmark:

@@ -1,0 +1,170 @@
+"""``GraspGaitRandom-v0``: a new object and friction at every reset (generalization)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from graspgait_env.envs.map_env import GraspGaitEnv, _finite
+from graspgait_env.envs.procedural import (
+    EVAL_SEEDS,
+    LEVELS,
+    SEED_RANGE,
+    ObjectSampler,
+    procedural_object,
+)
+from graspgait_env.errors import ConfigError
+from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.objects import load_object
+from graspgait_env.shapes import Circle, Shape
+from graspgait_env.workspace import Hand, load_hand
+
+__all__ = ["GraspGaitRandomEnv"]
+
+_OBJECT_TRIES = 20  # objects drawn per reset before giving up on finding a legal start
+
+
+class GraspGaitRandomEnv(GraspGaitEnv):
+    r"""``GraspGait-v0`` with the object and ``mu`` drawn anew at every reset.
+
+    ## Description
+
+    As :class:`~graspgait_env.envs.map_env.GraspGaitEnv` (actions, observation,
+    rewards, starting state and episode ends are the same, documented there), but each
+    ``reset`` draws, from ``self.np_random``:
+
+    - the object: with probability ``bundled_fraction`` a bundled object admitted at
+      ``level`` (:func:`~graspgait_env.envs.procedural.bundled_for_level`), otherwise
+      the procedural object of a seed drawn uniformly from ``object_seeds`` minus
+      ``exclude_seeds`` (:func:`~graspgait_env.envs.procedural.procedural_object`:
+      ellipses and star-shaped polygons, a pure function of ``(seed, level)``);
+    - ``mu`` uniformly from ``mu_range`` (default the level's range).
+
+    If the drawn object has no legal start grasp with a legal move, another is drawn
+    (up to 20 times, then ``RuntimeError`` names the level and ranges).
+
+    Levels (:data:`~graspgait_env.envs.procedural.LEVELS`): 0 nearly round objects
+    (eccentricity ≤ 1.3, 7–12 sides) at mu ∈ [0.6, 0.9]; 1 up to E = 1.9, 5–10 sides,
+    mu ≥ 0.45; 2 up to E = 2.6, 3–8 sides with star notches, mu ≥ 0.3; 3 up to E = 3.5,
+    deeper notches, mu ≥ 0.2.
+
+    The hand and ``n`` are fixed, so the action and observation spaces are the same for
+    every object (a reach-limited hand, whose workspaces depend on the object, is
+    refused). By default the seeds of
+    :data:`~graspgait_env.envs.procedural.EVAL_SEEDS` are excluded: evaluate on them with
+    ``object_seeds=EVAL_SEEDS, exclude_seeds=None, bundled_fraction=0``.
+
+    ``reset(options=...)`` may fix the episode's object: ``{"object": name | path |
+    Shape}`` or ``{"object_seed": int}`` (procedural at this level), and ``{"mu": float}``;
+    ``{"start": ...}`` as in ``GraspGait-v0``. The reset ``info`` names the object,
+    ``mu`` and ``object_seed`` (-1 for a bundled or given object).
+
+    ## Arguments
+
+    ``gymnasium.make("graspgait_env:GraspGaitRandom-v0", level=0, mu_range=None,
+    object_seeds=(0, 2**31 - 1), exclude_seeds=EVAL_SEEDS, bundled_fraction=0.2,
+    hand=None, turn_deg=360.0, n=180, **reward_and_window_kwargs, render_mode=None)``;
+    the keyword arguments after ``n`` are those of ``GraspGait-v0``.
+
+    ## Version History
+
+    - v0: initial version.
+    """
+
+    def __init__(
+        self,
+        level: int = 0,
+        mu_range: tuple[float, float] | None = None,
+        object_seeds: tuple[int, int] = SEED_RANGE,
+        exclude_seeds: tuple[int, int] | None = EVAL_SEEDS,
+        bundled_fraction: float = 0.2,
+        hand: str | Hand | None = None,
+        turn_deg: float = 360.0,
+        n: int = 180,
+        *,
+        alpha: float = 1.0,
+        beta: float = 0.01,
+        gamma: float = 0.01,
+        turn_scale_deg: float | None = None,
+        success_bonus: float = 1.0,
+        dead_end_penalty: float = 1.0,
+        illegal_penalty: float = 0.1,
+        max_backward_deg: float = 360.0,
+        map_window_deg: float = 360.0,
+        map_window_cells: int = 36,
+        render_mode: str | None = None,
+    ) -> None:
+        self._configure(turn_deg=turn_deg, alpha=alpha, beta=beta, gamma=gamma,
+                        turn_scale_deg=turn_scale_deg, success_bonus=success_bonus,
+                        dead_end_penalty=dead_end_penalty, illegal_penalty=illegal_penalty,
+                        max_backward_deg=max_backward_deg, map_window_deg=map_window_deg,
+                        map_window_cells=map_window_cells, render_mode=render_mode)
+        self.sampler = ObjectSampler(level, object_seeds, exclude_seeds, bundled_fraction)
+        self.level = self.sampler.level
+        if mu_range is not None:
+            try:
+                lo, hi = (_finite("mu_range", v, positive=True) for v in mu_range)
+            except TypeError:
+                raise ValueError(
+                    f"mu_range={mu_range!r}: give (lo, hi) with 0 < lo <= hi") from None
+            if lo > hi:
+                raise ValueError(f"mu_range={mu_range!r}: give (lo, hi) with 0 < lo <= hi")
+            mu_range = (lo, hi)
+        self.mu_range = mu_range
+        try:
+            self.hand, _ = load_hand(hand, None)
+        except ConfigError as exc:
+            if exc.field != "reach":
+                raise
+            raise ValueError(
+                f"hand={hand!r}: a reach-limited hand's workspaces depend on the object, so the "
+                "action space would change between objects; give a hand with fixed "
+                "workspaces_deg (e.g. 'thesis')") from None
+        self.object_seed = -1
+        lo, hi = LEVELS[self.level].mu if mu_range is None else mu_range
+        # the spaces depend only on the hand and n: any object sets them up
+        self._use_model(GaitModel(Circle(0.08, name="placeholder"), 0.5 * (lo + hi), self.hand,
+                                  n))
+        self._make_spaces()
+
+    def _model_for(self, shape: Shape, mu: float) -> GaitModel:
+        model = GaitModel(shape, mu, self.hand, self._n)
+        self._check_model_fits(model)
+        return model
+
+    def _on_reset(self, options: dict[str, Any]) -> GaitState | None:
+        rng = self.np_random
+        given = "object" in options or "object_seed" in options or "mu" in options
+        if given:
+            if "object" in options:
+                shape, seed = load_object(options["object"]), -1
+            elif "object_seed" in options:
+                seed = int(options["object_seed"])
+                shape = procedural_object(seed, self.level)
+            else:
+                shape, seed = self.sampler.sample(rng)
+            mu = (float(options["mu"]) if "mu" in options
+                  else self.sampler.sample_mu(rng, self.mu_range))
+            self._use_model(self._model_for(shape, mu))
+            self.object_seed = seed
+            return None  # _draw_start / the given start report a problem with this object
+        for _ in range(_OBJECT_TRIES):
+            shape, seed = self.sampler.sample(rng)
+            mu = self.sampler.sample_mu(rng, self.mu_range)
+            self._use_model(self._model_for(shape, mu))
+            self.object_seed = seed
+            if "start" in options:
+                return None
+            try:
+                return self._draw_start()
+            except ValueError:
+                continue
+        raise RuntimeError(
+            f"level {self.level}: {_OBJECT_TRIES} objects drawn in a row had no legal start "
+            f"grasp with a legal move (mu_range={self.mu_range}, seeds "
+            f"{self.sampler.object_seeds}); raise mu_range or lower the level")
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Draw an object and ``mu``, then start an episode (see the class docstring)."""
+        obs, info = super().reset(seed=seed, options=options)
+        info["object_seed"] = self.object_seed
+        return obs, info
