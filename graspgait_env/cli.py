@@ -8,6 +8,7 @@
                    [--motion F] [--png F]
     graspgait bench [--objects ...] [--mus 0.8,0.7] [--planners ...] [--starts 10]
                     [--csv F] [--json F] [--md F]
+    graspgait simulate PLAN.json [--video F.mp4] [--json F] [--perturb DX,DY,DTH|random]
     graspgait perf [--repeat 100] [--json F]
 
 Exit status: 0 on success; 2 on bad input (an argument, a file, a field), with one
@@ -357,6 +358,37 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_bench)
 
 
+# --- simulate -------------------------------------------------------------------------
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    # imported here so that MUJOCO_GL=egl is set (graspgait_env.sim) before MuJoCo loads
+    from graspgait_env.sim.simulate import simulate_command
+
+    return simulate_command(args.plan, video=args.video, seed=args.seed, perturb=args.perturb,
+                            config=args.config, json_out=args.json, progress=not args.quiet)
+
+
+def _add_simulate(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("simulate", help="execute a plan on the MuJoCo hand (thesis ch. 7)",
+                       description="Execute PLAN.json on the simulated three-finger hand with "
+                       "the thesis controller (trajectory planner, PD servo, grip-force and "
+                       "friction-cone check, object localizer) and report success, rotation, "
+                       "final errors, drops, slips, sim and wall time. Exit 0 when the gait "
+                       "succeeds, 1 when the hand fails it, 2 for bad input.")
+    p.add_argument("plan", metavar="PLAN.json", help="a plan written by `graspgait plan`")
+    p.add_argument("--video", metavar="FILE.mp4", help="render a video (headless, EGL)")
+    p.add_argument("--json", metavar="FILE", help="write the result JSON")
+    p.add_argument("--perturb", metavar="DX,DY,DTH|random",
+                   help="initial object pose error: metres, metres, degrees; or 'random' "
+                   "(up to 6 mm and 5 deg, from --seed)")
+    p.add_argument("--seed", type=int, default=0, help="seed for --perturb random")
+    p.add_argument("--config", metavar="SIM.yaml", help="simulation config "
+                   "(default configs/sim/default.yaml)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_simulate)
+
+
 # --- registry -------------------------------------------------------------------------
 # Later subcommands (plan, bench, simulate, train; DESIGN.md) are added HERE: write
 # `_cmd_X(args) -> int` and `_add_X(sub)` as above and append `_add_X` below. Register
@@ -366,6 +398,7 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_sweep,
     _add_plan,
     _add_bench,
+    _add_simulate,
     _add_perf,
 ]
 

@@ -80,7 +80,11 @@ class BenchRow:
 Benchmark = Callable[[int], list[BenchRow]]
 BENCHMARKS: list[Benchmark] = []
 # Modules whose import registers more benchmarks (later issues append theirs here).
-BENCHMARK_MODULES: list[str] = ["baselines.bench", "graspgait_env.envs.bench"]
+BENCHMARK_MODULES: list[str] = [
+    "baselines.bench",
+    "graspgait_env.envs.bench",
+    "graspgait_env.sim.perf_rows",
+]
 
 
 def register(fn: Benchmark) -> Benchmark:
