@@ -5,6 +5,8 @@ Ids (registered by :func:`register_envs`, which ``import graspgait_env`` calls):
 - ``GraspGait-v0`` (:class:`GraspGaitEnv`): one object, set by keyword arguments.
 - ``GraspGaitRandom-v0`` (:class:`GraspGaitRandomEnv`): a new object and friction at
   every reset, by difficulty level.
+- ``GraspGaitMujoco-v0`` (:class:`GraspGaitMujocoEnv`): the same spaces, each move
+  executed on the MuJoCo hand by the thesis controller (ch. 7).
 
 The environment classes are imported lazily (``from graspgait_env.envs import
 GraspGaitEnv`` works), so importing this package costs no more than Gymnasium's
@@ -20,6 +22,7 @@ from graspgait_env.envs.registration import ENV_IDS, register_envs
 __all__ = [
     "ENV_IDS",
     "GraspGaitEnv",
+    "GraspGaitMujocoEnv",
     "GraspGaitRandomEnv",
     "register_envs",
     "state_from_observation",
@@ -29,6 +32,7 @@ _LAZY = {
     "GraspGaitEnv": "graspgait_env.envs.map_env",
     "state_from_observation": "graspgait_env.envs.map_env",
     "GraspGaitRandomEnv": "graspgait_env.envs.random_env",
+    "GraspGaitMujocoEnv": "graspgait_env.envs.mujoco_env",
 }
 
 register_envs()

@@ -1,0 +1,377 @@
+"""``GraspGaitMujoco-v0``: the grasp-gait env with every move executed in MuJoCo (thesis ch. 7).
+
+:class:`GraspGaitMujocoEnv` is :class:`~graspgait_env.envs.map_env.GraspGaitEnv` (same
+spaces, observation layout, reward terms and mask function) whose legal actions are
+turned into plan steps and executed on the simulated hand by the thesis controller
+(:class:`~graspgait_env.sim.executor.GaitExecutor`). See the class docstring.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from graspgait_env.envs.map_env import REWARD_TERMS, GraspGaitEnv, _finite
+from graspgait_env.gait import ROTATE, GaitState
+from graspgait_env.shapes import Shape
+from graspgait_env.sim.config import SimConfig, load_sim_config
+from graspgait_env.sim.executor import GaitExecutor, StepReport, random_pose_perturbation
+from graspgait_env.workspace import Hand
+
+__all__ = ["GraspGaitMujocoEnv", "MUJOCO_WARNINGS"]
+
+# mjtWarning names, in MuJoCo's index order (mjData.warning[i] counts warning i)
+MUJOCO_WARNINGS: tuple[str, ...] = tuple(mujoco.mjtWarning(i).name
+                                         for i in range(mujoco.mjtWarning.mjNWARNING.value))
+_START_TRIES = 4  # start grasps tried at reset before giving up on a physical grasp
+
+
+class GraspGaitMujocoEnv(GraspGaitEnv):
+    r"""``GraspGait-v0`` with every move executed on the simulated hand (thesis ch. 7).
+
+    ## Description
+
+    The map-level grasp-gait problem of :class:`~graspgait_env.envs.map_env.GraspGaitEnv`
+    played on the MuJoCo model of the thesis hand (three 3-DOF point fingers with ball
+    tips, the object on a table). The env keeps the map-level :class:`GaitState` as the
+    **commanded state** (the plan so far); each legal action is turned into a plan step
+    (``{"op": "rotate", "delta": deg}`` or ``{"op": "regrasp", "contacts": {...}}``,
+    DESIGN.md) and executed by :class:`~graspgait_env.sim.executor.GaitExecutor`, the
+    thesis controller (trajectory planner, PD servo, grip and friction cone check,
+    object localizer; thesis 7.3-7.4). Physics is deterministic: an episode is a pure
+    function of the start grasp, the pose perturbation and the actions.
+
+    ## Action Space
+
+    As ``GraspGait-v0``: ``Discrete(model.n_actions)`` (182 with the thesis hand).
+    An illegal action is a penalized no-op that runs no physics.
+
+    ## Observation Space
+
+    As ``GraspGait-v0`` (same ``Box``, same layout, built by the same methods): the
+    header and the grasp-map window describe the **commanded** state, so
+    :func:`~graspgait_env.envs.map_env.state_from_observation` recovers it exactly
+    (and :class:`baselines.policies.PlannerPolicy` works unchanged). Only the mask entries
+    (and ``info["action_mask"]``, ``action_masks()``) use the localizer's estimate:
+
+    - the controller's estimated object angle ``θ̂`` (``StepReport.pose_estimate``) is
+      rounded to the grid, ``k̂ = round(θ̂ / Δ)``;
+    - if ``k̂ = k`` (the estimate lies within half a grid step of the commanded angle:
+      always after a rotation, whose end the controller dead-reckons onto the commanded
+      angle, thesis 7.4.5) the mask is ``model.action_mask(state)``, as at map level;
+    - otherwise (after a regrasp, or when the initial probe found the object off by
+      more than half a step) the regrasps whose new contact would lie outside the free
+      finger's workspace at ``k̂`` are removed: the controller places the new finger
+      on the contact at the *estimated* pose. Rotations keep the commanded mask: the
+      controller folds the orientation error into the next rotation (thesis 7.4.5,
+      7.5), so a rotation by ``d`` ends at the commanded angle ``k + d``, where the
+      map-level mask checks the workspaces. If the restriction leaves no move, the
+      commanded mask is kept (the estimate never makes a false dead end), and after
+      any rotation ``k̂ = k`` again. ``info["mask_from_estimate"]`` says whether it
+      removed a move. (A policy that ignores the mask, such as
+      :class:`baselines.policies.PlannerPolicy`, may then play an illegal regrasp, a
+      no-op, again and again: mask-aware agents do not.)
+
+    ## Rewards
+
+    The six terms of ``GraspGait-v0`` (``REWARD_TERMS``), summed in the same order;
+    ``reward == sum(info["reward_terms"].values())`` exactly. A move that ends in a
+    drop, a failed contact or a MuJoCo warning costs its move term (``regrasp`` or
+    ``rotation``) and ``dead_end``; it earns no ``turn``.
+
+    ## Starting State
+
+    As ``GraspGait-v0`` (θ = 0, a start grasp drawn by ``self.np_random``, or
+    ``options["start"]``), then the object is placed at the centre plus a pose
+    perturbation unknown to the controller, drawn from ``self.np_random`` uniformly in
+    a disc of radius ``pose_noise[0]`` (m) and an angle in ``±pose_noise[1]`` (deg)
+    (default ``(0, 0)``: the object exactly placed; the thesis tested ``(0.006, 5)``,
+    ``pose_noise="thesis"``). The controller probes and localizes the object, then makes
+    the start grasp (``GaitExecutor.reset``). A fresh MuJoCo model is built at every
+    reset (~30 ms), so no physics state carries from one episode to the next. If the
+    grasp fails (a drop or no contact) another start grasp is drawn (up to 4 tries,
+    then ``RuntimeError``; with ``options["start"]`` it raises at once).
+
+    ## Episode End
+
+    - **Success** (terminated, ``is_success``): the turn reaches ``turn_deg``. It is
+      judged on the commanded angle, which is also the estimated one (success comes
+      from a rotation, after which the estimate equals the commanded angle). The true
+      angle is reported in ``info["true_turn_deg"]``.
+    - **Drop** (terminated, ``info["dropped"] = True``, ``is_success`` False,
+      ``dead_end`` term): the executor's monitor found the object lost.
+      ``info["sim_status"]`` is ``"dropped"``; a regrasp whose finger finds no object
+      ends the episode the same way with ``sim_status = "no-contact"`` (``dropped``
+      False).
+    - **MuJoCo warning** (terminated, ``info["mujoco_warning"]`` the warning's name,
+      e.g. ``"mjWARN_BADQACC"``, ``dead_end`` term): any ``mjData.warning`` counter
+      rose during the move. MuJoCo resets its data after such a warning; the episode is
+      ended rather than continued on a silently reset simulation.
+    - Dead end, wrong way and truncation as in ``GraspGait-v0``.
+
+    After a terminal move the mask is all False.
+
+    ## Info
+
+    The keys of ``GraspGait-v0`` plus ``dropped``, ``sim_status`` (``ok``, ``dropped``,
+    ``no-contact``, ``warning`` or ``skipped`` for an illegal action), ``mujoco_warning``
+    (a name or None), ``pose_estimate`` (x m, y m, θ deg), ``estimated_turn_deg``,
+    ``true_turn_deg``, ``mask_from_estimate`` and ``sim_time_s`` (simulated time).
+
+    ## Arguments
+
+    ``gymnasium.make("graspgait_env:GraspGaitMujoco-v0", object="ellipse", mu=0.7,
+    hand=None, turn_deg=360.0, n=180, sim_config=None, pose_noise=(0.0, 0.0), **kw)``
+
+    - ``object, mu, hand, turn_deg, n`` and every keyword of ``GraspGait-v0`` (reward
+      weights, ``max_backward_deg``, map window, ``render_mode``): as there. ``mu`` is
+      the planning friction (the controller's friction cone check uses it); the
+      contacts' true friction is ``sim_config.finger_mu``.
+    - ``sim_config``: :class:`~graspgait_env.sim.config.SimConfig`, a YAML path or None
+      for ``configs/sim/default.yaml``.
+    - ``pose_noise``: ``(max_offset_m, max_angle_deg)`` of the initial pose
+      perturbation, or ``"thesis"`` for ``(0.006, 5.0)``.
+    - ``render_mode``: ``"rgb_array"``/``"human"`` draw the map-level frame of
+      ``GraspGait-v0`` (commanded state and gait so far), not a MuJoCo camera image:
+      it needs no GL context and costs the same as at map level.
+
+    Attributes: ``executor`` (the :class:`GaitExecutor` of the present episode, None
+    before the first reset) and ``physics`` (its by-name MuJoCo accessor).
+
+    ## Pickling
+
+    MuJoCo objects do not pickle. ``pickle`` and ``copy.deepcopy`` store the episode's
+    start grasp, perturbation and executed plan steps, and rebuild the simulation by
+    replaying them (deterministic; the replayed physics state is checked bit for bit).
+    A disturbance set with ``executor.set_disturbance`` is not part of the replay.
+
+    ## Version History
+
+    - v0: initial version.
+    """
+
+    def __init__(
+        self,
+        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (DESIGN.md OBJECT)
+        mu: float = 0.7,
+        hand: str | Hand | None = None,
+        turn_deg: float = 360.0,
+        n: int = 180,
+        *,
+        sim_config: SimConfig | str | None = None,
+        pose_noise: tuple[float, float] | str = (0.0, 0.0),
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(object, mu, hand, turn_deg, n, **kwargs)
+        if isinstance(pose_noise, str):
+            if pose_noise != "thesis":
+                raise ValueError(f"pose_noise={pose_noise!r}: give (max_offset_m, "
+                                 "max_angle_deg) or 'thesis' for (0.006, 5.0)")
+            pose_noise = (0.006, 5.0)
+        try:
+            off, ang = pose_noise
+        except (TypeError, ValueError):
+            raise ValueError(f"pose_noise={pose_noise!r}: give (max_offset_m, max_angle_deg), "
+                             "e.g. (0.006, 5.0)") from None
+        self.pose_noise = (_finite("pose_noise[0]", off, nonneg=True),
+                           _finite("pose_noise[1]", ang, nonneg=True))
+        self.sim_config = (sim_config if isinstance(sim_config, SimConfig)
+                           else load_sim_config(sim_config))
+        # the executor loads the object's physical fields from its file when it has one
+        self._sim_object: str | Shape = object if isinstance(object, str) else self.model.shape
+        self.executor: GaitExecutor | None = None
+        self._est_k: int | None = None  # estimated angle on the grid (None: use commanded)
+        self._replay: dict[str, Any] | None = None
+
+    # ------------------------------------------------------------------ simulation
+    @property
+    def physics(self):
+        """The present episode's :class:`~graspgait_env.sim.model.HandPhysics` (or None)."""
+        return None if self.executor is None else self.executor.physics
+
+    def _make_executor(self) -> GaitExecutor:
+        return GaitExecutor(self._sim_object, mu=self.model.mu, config=self.sim_config,
+                            workspaces_deg=[tuple(w) for w in self.model.hand.workspaces_deg])
+
+    def _warning_counts(self) -> list[int]:
+        return [int(w.number) for w in self.executor.physics.data.warning]
+
+    def _new_warning(self, before: list[int]) -> str | None:
+        after = self._warning_counts()
+        for name, b, a in zip(MUJOCO_WARNINGS, before, after, strict=False):
+            if a > b:
+                return name
+        return None
+
+    def _contacts_deg(self, contacts: tuple[int, ...]) -> dict[str, float]:
+        return {str(f + 1): self.model.contact_deg(c) for f, c in enumerate(contacts) if c >= 0}
+
+    def _plan_step(self, s: GaitState, action: int) -> dict[str, Any]:
+        """The DESIGN.md plan step of a legal ``action`` in state ``s``."""
+        m = self.model.decode(s, action)
+        if m.kind == ROTATE:
+            return {"op": "rotate", "delta": m.delta * self._step_deg}
+        return {"op": "regrasp", "contacts": self._contacts_deg(self.model.apply(s, action)
+                                                               .contacts)}
+
+    def _set_estimate(self, report: StepReport) -> None:
+        self._est_theta = float(report.pose_estimate[2])
+        self._est_k = int(round(self._est_theta / self._step_deg))
+
+    def _fingerprint(self) -> bytes:
+        d = self.executor.physics.data
+        return d.qpos.tobytes() + d.qvel.tobytes() + np.float64(d.time).tobytes()
+
+    # ------------------------------------------------------------------ mask
+    def _compute_mask(self) -> NDArray[np.bool_]:
+        """The map-level mask of the commanded state; when the estimated angle is off
+        the commanded one by more than half a grid step, regrasps whose new contact
+        would lie outside the free finger's workspace at the estimated angle are
+        removed (see *Observation Space*)."""
+        mask = super()._compute_mask()
+        self._restricted = False
+        if self._est_k is None or self._est_k == self._k:
+            return mask
+        dk = self._est_k - self._k
+        b = 2 * self._R
+        p = np.arange((self._A - b) // 2)  # workspace position of each regrasp target
+        inside = (p + dk >= 0) & (p + dk < self._W[self._h])
+        restricted = mask.copy()
+        restricted[b::2] &= inside
+        restricted[b + 1::2] &= inside
+        if not restricted.any():
+            return mask
+        self._restricted = bool((restricted != mask).any())
+        return restricted
+
+    # ------------------------------------------------------------------ API
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[NDArray[np.float32], dict]:
+        """Draw a start grasp (``GraspGait-v0``), place the object with the pose
+        perturbation and make the grasp on the simulated hand; returns ``(obs, info)``."""
+        given = options is not None and options.get("start") is not None
+        failures = []
+        for attempt in range(1 if given else _START_TRIES):
+            self._est_k = None
+            obs, info = super().reset(seed=seed if attempt == 0 else None, options=options)
+            pert = (0.0, 0.0, 0.0)
+            if self.pose_noise != (0.0, 0.0):
+                pert = random_pose_perturbation(self.np_random, *self.pose_noise)
+            contacts = self._contacts_deg(tuple(self._c))
+            self.executor = self._make_executor()
+            before = self._warning_counts()
+            report = self.executor.reset(contacts, pose_perturbation=pert)
+            warn = self._new_warning(before)
+            if report.ok and warn is None:
+                break
+            failures.append(f"{contacts}: {warn or report.status} {report.message}".strip())
+        else:
+            raise RuntimeError(
+                f"object {self.model.shape.name!r} at mu={self.model.mu:g}: the simulated "
+                f"hand could not make the start grasp ({'; '.join(failures)}); try another "
+                "start, a smaller pose_noise or a higher sim_config.finger_mu")
+        self._replay = {"contacts": contacts, "pert": pert, "steps": []}
+        self._set_estimate(report)
+        self._mask = self._compute_mask()
+        if not self._mask.any():  # cannot happen: the commanded mask is kept then
+            raise RuntimeError("no legal move at the start")
+        self._write_motion()
+        info["action_mask"] = self._mask
+        info.update(self._sim_info(report, None))
+        return self._obs.copy(), info
+
+    def _sim_info(self, report: StepReport | None, warning: str | None) -> dict[str, Any]:
+        ex = self.executor
+        est = ex.pose_estimate()
+        return {
+            "dropped": bool(ex.dropped),
+            "sim_status": ("skipped" if report is None
+                           else "warning" if warning is not None else report.status),
+            "mujoco_warning": warning,
+            "pose_estimate": est,
+            "estimated_turn_deg": est[2],
+            "true_turn_deg": float(ex.theta_true),
+            "mask_from_estimate": self._restricted,
+            "sim_time_s": ex.time,
+        }
+
+    def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
+        """Execute one move on the simulated hand; see the class docstring."""
+        if self.executor is None:
+            raise RuntimeError("step: call reset() first")
+        a = int(action)
+        if not 0 <= a < self._A or not self._mask[a]:  # out of range (raises) or illegal
+            out = super().step(action)
+            out[4].update(self._sim_info(None, None))
+            return out
+        plan_step = self._plan_step(self.state, a)
+        before = self._warning_counts()
+        report = self.executor.execute(plan_step)
+        self._replay["steps"].append(plan_step)
+        warning = self._new_warning(before)
+        if warning is not None or not report.ok:
+            return self._failed_move(plan_step, report, warning)
+        self._set_estimate(report)
+        obs, reward, terminated, truncated, info = super().step(a)
+        info.update(self._sim_info(report, None))
+        return obs, reward, terminated, truncated, info
+
+    def _failed_move(self, plan_step: dict[str, Any], report: StepReport,
+                     warning: str | None) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
+        """A drop, a failed contact or a MuJoCo warning: the episode ends; the commanded
+        state stays where it was (the move did not complete)."""
+        terms = dict.fromkeys(REWARD_TERMS, 0.0)
+        if plan_step["op"] == "rotate":
+            terms["rotation"] = -self.gamma
+            self._rotations += 1
+        else:
+            terms["regrasp"] = -self.beta
+            self._regrasps += 1
+        if not self._terminal:
+            terms["dead_end"] = -self.dead_end_penalty
+        self._terminal = True
+        self._restricted = False
+        self._mask = np.zeros(self._A, dtype=bool)
+        self._mask_view[...] = self._mask
+        t = terms
+        reward = (t["turn"] + t["regrasp"] + t["rotation"] + t["success"] + t["dead_end"]
+                  + t["illegal"])
+        info = {
+            "action_mask": self._mask,
+            "reward_terms": terms,
+            "is_success": False,
+            "turn_deg": self._k * self._step_deg,
+            "regrasps": self._regrasps,
+        }
+        info.update(self._sim_info(report, warning))
+        if warning is None and report.status == "dropped":
+            info["dropped"] = True
+        return self._obs.copy(), reward, True, False, info
+
+    # ------------------------------------------------------------------ pickling
+    def __getstate__(self) -> dict[str, Any]:
+        d = super().__getstate__()
+        ex = d.pop("executor", None)
+        d["_fingerprint"] = None if ex is None else self._fingerprint()
+        d["_disturbed"] = ex is not None and ex.disturbance_fn is not None
+        return d
+
+    def __setstate__(self, d: dict[str, Any]) -> None:
+        fingerprint = d.pop("_fingerprint", None)
+        d.pop("_disturbed", None)
+        super().__setstate__(d)
+        self.executor = None
+        if self._replay is None:
+            return
+        self.executor = self._make_executor()
+        rep = self._replay
+        self.executor.reset(rep["contacts"], pose_perturbation=rep["pert"])
+        for st in rep["steps"]:
+            self.executor.execute(st)
+        if fingerprint is not None and self._fingerprint() != fingerprint:
+            raise RuntimeError("unpickling GraspGaitMujocoEnv: replaying the episode's "
+                               f"{len(rep['steps'])} steps did not reproduce the physics "
+                               "state (was a disturbance applied?)")
