@@ -74,8 +74,9 @@ Back-and-forth gait (6.3.2), counter-clockwise only:
   far edge", so rules 2–4 and 6–11 reposition it in time.
 - Ties between the rotation limit and the upper/right limit go to the backward rules.
 - Initial conditions (last paragraph of 6.3.2): a start past its upper/right limit is
-  first turned back (clockwise) by the deficit; if a finger at the start of its
-  workspace blocks that, the preparatory backward step on the other axis comes first.
+  first turned back (clockwise) by the deficit, as far as the workspaces allow; when a
+  finger at the start of its workspace blocks the turn, the preparatory backward step
+  on the other axis is taken, and the turn back goes on.
   From some starts the rules still get stuck; the result then says where, and
   :func:`rule_based` goes on to the modified search. With ``start=None`` the rules
   start inside the box and, on synthetic box maps, succeed exactly when the box
@@ -426,8 +427,9 @@ class _BoxGait:
             d = min(lims)
             if d < 0:
                 # initial condition past the limit: turn back first (6.3.2, last paragraph)
-                if -d <= min(px, py):
-                    self.trace.rotate(d, "6.3.2 turn back")
+                cap = min(px, py)
+                if cap > 0:  # as far as the workspaces allow
+                    self.trace.rotate(max(d, -cap), "6.3.2 turn back")
                     continue
                 # a finger at the start of its workspace blocks the turn back: take the
                 # backward rules' preparatory step on the other axis first (rule 6 / 9)

@@ -237,7 +237,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         from baselines.rule_based import diagnose_no_gait
 
         why = res.reason or "no gait found"
-        raise NoGaitError(f"{why}; diagnosis: {diagnose_no_gait(model, start)}")
+        raise NoGaitError(f"{why}; diagnosis: {diagnose_no_gait(model, start, args.turn)}")
     v = validate_plan(res.plan, model.shape, model.hand, args.turn, model.max_radius)
     if v is not None:  # a planner bug, never the user's input
         raise RuntimeError(f"planner {args.planner} returned an invalid plan: "
