@@ -43,9 +43,18 @@ def test_one_perturbed_ellipse_gait():
     assert r["rotation_deg"] == pytest.approx(356.0, abs=ANGLE_TOL_DEG)
 
 
+# Known shortfall (issue 5 open): the pentagon's rule plan (modified search) grasps 2 deg
+# from the vertices at the workspace edges and the 7.8 mm ball tip rolls off the corner:
+# 0/10 runs survive. Strict, so the mark must go when a vertex-clearance fix lands.
+_PENTAGON_RULE = pytest.param(
+    "pentagon", "rule", marks=pytest.mark.xfail(
+        strict=True, reason="rule plan grasps 2 deg from pentagon vertices: ball tip rolls off"))
+CASES = [(o, p) for p in ("optimal", "rule") for o in THESIS_OBJECTS
+         if (o, p) != ("pentagon", "rule")] + [_PENTAGON_RULE]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("planner", ["optimal", "rule"])
-@pytest.mark.parametrize("obj", THESIS_OBJECTS)
+@pytest.mark.parametrize(("obj", "planner"), CASES)
 def test_360_degree_gaits_survive_perturbed_starts(obj, planner):
     plan = _plan_or_skip(obj, planner)
     results = [simulate_plan(plan, pose_perturbation="random", seed=seed)
