@@ -227,7 +227,11 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         raise GraspGaitInputError(f"--turn {args.turn!r}: give a non-zero finite angle in "
                                   "degrees (positive counter-clockwise), e.g. 360")
     get_planner(args.planner)  # refuse unknown names before any work
-    model = GaitModel(args.object, mu, hand=args.hand, n=n)
+    clearance = args.vertex_clearance
+    if not (math.isfinite(clearance) and 0 <= clearance < 90):
+        raise GraspGaitInputError(f"--vertex-clearance {clearance!r}: give degrees in "
+                                  "[0, 90), e.g. 4 for plans run on the MuJoCo hand")
+    model = GaitModel(args.object, mu, hand=args.hand, n=n, vertex_clearance_deg=clearance)
     start = _parse_start(args.start, model)
     res = run_planner(args.planner, model, start, args.turn)
     print(model.shape.describe())
@@ -290,6 +294,10 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--n", type=int, default=180, help="grid: contacts and rotation steps "
                    "of 360/n deg (default 180)")
     p.add_argument("--hand", default=None, help="bundled hand name or hand YAML path")
+    p.add_argument("--vertex-clearance", type=float, default=0.0, metavar="DEG",
+                   help="keep contacts DEG degrees off polygon vertices (default 0, the "
+                   "thesis's point contacts; 4 for plans run by `graspgait simulate`: a ball "
+                   "tip rolls off corners)")
     p.add_argument("--json", metavar="FILE", help="write the plan JSON (DESIGN.md)")
     p.add_argument("--motion", metavar="FILE", help="write the thesis's motion_file (7.4.1)")
     p.add_argument("--png", metavar="FILE", help="draw the gait over the maps")

@@ -97,6 +97,9 @@ class GaitModel:
         Grid size: contacts and rotations in steps of ``360 / n`` degrees (default 180).
     max_radius
         Reach cap (m) for the grasp map (thesis fig. 4.3); a reach hand supplies its own.
+    vertex_clearance_deg
+        Keep contacts this many degrees away from polygon vertices (see
+        :func:`graspgait_env.grasp_map`); 0 (default) is the thesis's point-contact model.
 
     Attributes
     ----------
@@ -110,7 +113,8 @@ class GaitModel:
     """
 
     def __init__(self, shape: Shape | str, mu: float, hand: Hand | str | None = None,
-                 n: int = 180, max_radius: float | None = None) -> None:
+                 n: int = 180, max_radius: float | None = None,
+                 vertex_clearance_deg: float = 0.0) -> None:
         self.shape = load_object(shape)
         self.n = check_n(n)
         self.hand, hand_cap = load_hand(hand, self.shape)
@@ -121,7 +125,8 @@ class GaitModel:
         cap = max_radius if max_radius is not None else hand_cap
         self.max_radius = cap
         self.mu = float(mu)
-        self.grasp_map: GraspMap = grasp_map(self.shape, mu, self.n, max_radius=cap)
+        self.grasp_map: GraspMap = grasp_map(self.shape, mu, self.n, max_radius=cap,
+                                             vertex_clearance_deg=vertex_clearance_deg)
         self.stable: NDArray[np.bool_] = self.grasp_map.stable
         self.step_deg = 360.0 / self.n
         starts, widths = [], []

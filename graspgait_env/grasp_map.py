@@ -112,8 +112,17 @@ def _make(stable: NDArray[np.bool_], phi: NDArray[np.float64], mu: float, name: 
     return GraspMap(view, phi, mu, name, usable, tiled)
 
 
-def _usable(shape: Shape, phi: NDArray[np.float64], max_radius: float | None) -> NDArray[np.bool_]:
+def _usable(shape: Shape, phi: NDArray[np.float64], max_radius: float | None,
+            vertex_clearance_deg: float = 0.0) -> NDArray[np.bool_]:
     usable = ~shape.is_vertex(phi)
+    if vertex_clearance_deg:
+        if not (math.isfinite(vertex_clearance_deg) and 0 < vertex_clearance_deg < 90):
+            raise ValueError(f"vertex_clearance_deg={vertex_clearance_deg!r}: must be in "
+                             "[0, 90) degrees")
+        va = getattr(shape, "vertex_angles_deg", None)
+        if va is not None:
+            d = np.abs(np.mod(phi[:, None] - va[None, :] + 180.0, 360.0) - 180.0)
+            usable &= d.min(axis=1) > vertex_clearance_deg
     if max_radius is not None:
         if not (math.isfinite(max_radius) and max_radius > 0):
             raise ValueError(f"max_radius={max_radius!r}: must be a finite length > 0 (m)")
@@ -128,6 +137,7 @@ def grasp_map(
     *,
     max_radius: float | None = None,
     method: str = "nguyen",
+    vertex_clearance_deg: float = 0.0,
 ) -> GraspMap:
     """Compute the grasp map of ``shape`` at friction ``mu`` on an ``n``-point grid.
 
@@ -145,6 +155,11 @@ def grasp_map(
         unusable and never part of a stable grasp. ``None``: no limit.
     method
         ``"nguyen"`` (geometric, default, fastest) or ``"wrench"`` (thesis 3.2).
+    vertex_clearance_deg
+        Contacts within this polar angle (degrees) of a polygon vertex are unusable
+        (default 0: only contacts exactly on a vertex). A physical ball tip rolls along
+        the contour as the object turns and can roll off a corner the point-contact model
+        of the thesis never sees; a clearance keeps planned grasps away from corners.
 
     Returns
     -------
@@ -193,7 +208,7 @@ def grasp_map(
         stable = force_closure_wrench(P[I], N[I], P[J], N[J], mu)
     else:
         raise ValueError(f"method={method!r}: use 'nguyen' or 'wrench'")
-    usable = _usable(shape, phi, max_radius)
+    usable = _usable(shape, phi, max_radius, vertex_clearance_deg)
     stable &= usable[:, None] & usable[None, :]
     np.fill_diagonal(stable, False)
     return _make(stable, phi, mu, shape.name, usable)

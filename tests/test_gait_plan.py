@@ -160,3 +160,18 @@ def test_plan_from_states_and_turn(pentagon):
 def test_gait_model_refuses_two_finger_hand():
     with pytest.raises(GraspGaitInputError, match="exactly 3"):
         GaitModel("circle", 0.7, hand=Hand(((0.0, 90.0), (180.0, 270.0)), "two"))
+
+
+def test_vertex_clearance_keeps_contacts_off_corners():
+    # pentagon vertices at 18, 90, 162, 234, 306 deg (2-degree grid)
+    plain = GaitModel("pentagon", 0.7)
+    clear = GaitModel("pentagon", 0.7, vertex_clearance_deg=4.0)
+    usable = clear.grasp_map.usable
+    for v in (18, 90, 162, 234, 306):
+        for d in (-2, 0, 2):  # (4 deg away is the boundary: float-rounding decides)
+            assert not usable[(v + d) // 2 % 180], (v, d)
+        assert usable[(v + 6) // 2 % 180] and usable[(v - 6) // 2 % 180]
+    assert plain.grasp_map.usable[(18 + 2) // 2]
+    # clearance only removes grasps
+    assert not (clear.stable & ~plain.stable).any()
+    assert clear.stable.sum() < plain.stable.sum()

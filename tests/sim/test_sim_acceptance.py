@@ -43,14 +43,7 @@ def test_one_perturbed_ellipse_gait():
     assert r["rotation_deg"] == pytest.approx(356.0, abs=ANGLE_TOL_DEG)
 
 
-# Known shortfall (issue 5 open): the pentagon's rule plan (modified search) grasps 2 deg
-# from the vertices at the workspace edges and the 7.8 mm ball tip rolls off the corner:
-# 0/10 runs survive. Strict, so the mark must go when a vertex-clearance fix lands.
-_PENTAGON_RULE = pytest.param(
-    "pentagon", "rule", marks=pytest.mark.xfail(
-        strict=True, reason="rule plan grasps 2 deg from pentagon vertices: ball tip rolls off"))
-CASES = [(o, p) for p in ("optimal", "rule") for o in THESIS_OBJECTS
-         if (o, p) != ("pentagon", "rule")] + [_PENTAGON_RULE]
+CASES = [(o, p) for p in ("optimal", "rule") for o in THESIS_OBJECTS]
 
 
 @pytest.mark.slow
