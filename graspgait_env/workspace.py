@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from graspgait_env.errors import ConfigError
-from graspgait_env.objects import CONFIG_DIR, read_yaml_mapping
+from graspgait_env.objects import CONFIG_DIR, positive_length, read_yaml_mapping
 from graspgait_env.shapes import Shape
 
 __all__ = [
@@ -339,18 +339,11 @@ def load_hand(name_or_path: str | Path | Hand | None = None,
                 for c in b)):
             raise ConfigError(src, f"{fld}.base", f"expected [x, y] metres, got {b!r}",
                               "give the disc centre as [x, y]")
-        r = f["reach"]
-        if isinstance(r, bool) or not isinstance(r, (int, float)) or not (math.isfinite(r)
-                                                                          and r > 0):
-            raise ConfigError(src, f"{fld}.reach", f"{r!r} is not a positive length",
-                              "give the reach radius in metres")
-        fingers.append(CircularReach((float(b[0]), float(b[1])), float(r)))
+        r = positive_length(src, f"{fld}.reach", f["reach"])
+        fingers.append(CircularReach((float(b[0]), float(b[1])), r))
     max_radius = data.get("max_radius")
-    if max_radius is not None and (isinstance(max_radius, bool)
-                                   or not isinstance(max_radius, (int, float))
-                                   or not (math.isfinite(max_radius) and max_radius > 0)):
-        raise ConfigError(src, "max_radius", f"{max_radius!r} is not a positive length",
-                          "give the largest usable radius in metres, or drop the key")
+    if max_radius is not None:
+        max_radius = positive_length(src, "max_radius", max_radius)
     try:
         hand = effective_hand(fingers, shape, max_radius, str(name))
     except ConfigError as exc:  # the effective arcs overlap: say so once, about this file
@@ -359,4 +352,4 @@ def load_hand(name_or_path: str | Path | Hand | None = None,
     except ValueError as exc:
         raise ConfigError(src, "reach", str(exc).split("; ")[0],
                           str(exc).split("; ")[-1]) from None
-    return hand, (None if max_radius is None else float(max_radius))
+    return hand, max_radius
