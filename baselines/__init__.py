@@ -1,1 +1,8 @@
-"""The thesis's planners (chapters 5–6) and an exact optimum, as functions and policies."""
+"""The thesis's planners as scripted baseline policies, and the benchmark.
+
+- :mod:`baselines.policies`: :class:`~baselines.policies.PlannerPolicy`, any planner of
+  :data:`graspgait_env.planners.registry.PLANNERS` behind stable-baselines3's ``predict``;
+- :mod:`baselines.bench`: the thesis's Tables 1 and 6.1 regenerated (``graspgait bench``).
+
+The planners themselves are map-level code and live in :mod:`graspgait_env.planners`.
+"""

@@ -26,10 +26,10 @@ from typing import Any
 
 from tqdm.auto import tqdm
 
-from baselines.registry import get_planner
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.perf import BenchRow, register
+from graspgait_env.planners.registry import get_planner
+from graspgait_env.timing import BenchRow, register
 
 __all__ = ["BenchCase", "bench_starts", "run_bench", "markdown_report", "THESIS_TABLE_1",
            "THESIS_TABLE_6_1", "THESIS_OBJECTS"]
@@ -68,7 +68,7 @@ class BenchCase:
 
 def bench_starts(model: GaitModel, count: int = 10) -> list[GaitState]:
     """``count`` legal starts at θ = 0 with a 360° gait, spread evenly (see module doc)."""
-    from baselines.exact import optimal_gait
+    from graspgait_env.planners.exact import optimal_gait
 
     starts = model.start_states()
     if not starts:

@@ -7,9 +7,9 @@ One evaluation loop runs planners and learned agents alike::
     action, state = policy.predict(obs, state=None, episode_start=None, deterministic=True)
 
 A planner is any function ``planner(model, start_state, turn_deg) -> PlannerResult``
-(:mod:`baselines.result`; ``.plan`` a :class:`graspgait_env.plan.Plan` or ``None``):
-:func:`baselines.exact.optimal_gait`, and with the same signature the search planners
-(``baselines.search``) and the rule-based ones (``baselines.rule_based``).
+(:mod:`graspgait_env.planners.result`; ``.plan`` a :class:`graspgait_env.plan.Plan` or ``None``):
+:func:`graspgait_env.planners.exact.optimal_gait`, and with the same signature the search planners
+(``graspgait_env.planners.search``) and the rule-based ones (``graspgait_env.planners.rule_based``).
 
 How it works
 ------------
@@ -45,10 +45,10 @@ import numpy as np
 from gymnasium.vector import VectorEnv
 from numpy.typing import NDArray
 
-from baselines.result import PlannerResult
 from graspgait_env.envs.map_env import state_from_observation
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import Plan
+from graspgait_env.planners.result import PlannerResult
 from graspgait_env.workspace import Hand
 
 __all__ = ["PlannerPolicy", "Planner", "plan_states", "plan_actions", "rebased_model",

@@ -217,9 +217,9 @@ def _parse_start(text: str | None, model) -> object:
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
-    from baselines.registry import get_planner, run_planner
     from graspgait_env.gait import GaitModel
     from graspgait_env.plan import InvalidPlanError, validate_plan
+    from graspgait_env.planners.registry import get_planner, run_planner
 
     mu = _check_mu(args.mu)
     n = _check_n(args.n)
@@ -238,7 +238,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     print(f"planner {res.planner}: nodes opened {res.nodes_opened}, created "
           f"{res.nodes_created}, wall time {res.wall_time_s * 1000:.1f} ms")
     if res.plan is None:
-        from baselines.rule_based import diagnose_no_gait
+        from graspgait_env.planners.rule_based import diagnose_no_gait
 
         why = res.reason or "no gait found"
         raise NoGaitError(f"{why}; diagnosis: {diagnose_no_gait(model, start, args.turn)}")
@@ -275,7 +275,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _add_plan(sub: argparse._SubParsersAction) -> None:
-    from baselines.registry import PLANNERS
+    from graspgait_env.planners.registry import PLANNERS
 
     p = sub.add_parser("plan", help="plan a grasp gait (thesis ch. 5-6)",
                        description="Plan a gait turning OBJECT by TURN degrees with one of "
@@ -319,7 +319,7 @@ def _csv_list(flag: str, text: str, conv):
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     from baselines import bench
-    from baselines.registry import get_planner
+    from graspgait_env.planners.registry import get_planner
 
     mus = [_check_mu(m) for m in _csv_list("--mus", args.mus, float)]
     planners = _csv_list("--planners", args.planners, str)

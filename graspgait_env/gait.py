@@ -52,10 +52,49 @@ from graspgait_env.objects import load_object
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand, load_hand
 
-__all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP"]
+__all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP", "workspace_grid"]
 
 ROTATE = "rotate"
 REGRASP = "regrasp"
+
+
+def workspace_grid(workspaces_deg, n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Each finger's workspace on the ``360 / n``-degree grid (thesis 4.1, 5.2).
+
+    The one definition of the workspace rounding: a workspace ``[lo, hi]`` (degrees,
+    frame ``F``) holds the grid angles ``a`` with ``lo <= a * 360 / n <= hi`` (to 1e-9 of
+    a step, so that 90° on a 2° grid is inside).
+
+    Parameters
+    ----------
+    workspaces_deg
+        ``[(lo, hi), ...]`` per finger, degrees, counter-clockwise from ``lo`` to ``hi``.
+    n
+        Grid size.
+
+    Returns
+    -------
+    ws_start, ws_width
+        Per finger: the unwrapped grid index of workspace position 0, and the number
+        ``W_f`` of grid angles in the workspace.
+
+    Raises
+    ------
+    GraspGaitInputError
+        A workspace holds no grid angle.
+    """
+    step = 360.0 / n
+    starts, widths = [], []
+    for f, (lo, hi) in enumerate(workspaces_deg):
+        a0 = math.ceil(lo / step - 1e-9)
+        a1 = math.floor(hi / step + 1e-9)
+        if a1 < a0:
+            raise GraspGaitInputError(
+                f"workspaces_deg[{f}]={[lo, hi]}: holds no grid angle at n={n}; "
+                "widen the workspace or raise n")
+        starts.append(a0)
+        widths.append(a1 - a0 + 1)
+    return np.array(starts, dtype=np.int64), np.array(widths, dtype=np.int64)
 
 
 class GaitState(NamedTuple):
@@ -129,18 +168,7 @@ class GaitModel:
                                              vertex_clearance_deg=vertex_clearance_deg)
         self.stable: NDArray[np.bool_] = self.grasp_map.stable
         self.step_deg = 360.0 / self.n
-        starts, widths = [], []
-        for f, (lo, hi) in enumerate(self.hand.workspaces_deg):
-            a0 = math.ceil(lo / self.step_deg - 1e-9)
-            a1 = math.floor(hi / self.step_deg + 1e-9)
-            if a1 < a0:
-                raise GraspGaitInputError(
-                    f"workspaces_deg[{f}]={[lo, hi]}: holds no grid angle at n={self.n}; "
-                    "widen the workspace or raise n")
-            starts.append(a0)
-            widths.append(a1 - a0 + 1)
-        self.ws_start = np.array(starts, dtype=np.int64)
-        self.ws_width = np.array(widths, dtype=np.int64)
+        self.ws_start, self.ws_width = workspace_grid(self.hand.workspaces_deg, self.n)
         self.R = int(self.ws_width.max()) - 1
         self.P = int(self.ws_width.max())
         self.n_actions = 2 * self.R + 2 * self.P
@@ -156,6 +184,26 @@ class GaitModel:
         """Workspace position of ``finger`` holding ``contact`` at angle ``k``; -1 if outside."""
         p = (contact + k - int(self.ws_start[finger])) % self.n
         return int(p) if p < self.ws_width[finger] else -1
+
+    def rotation_room(self, f: int, pf: int, g: int, pg: int) -> tuple[int, int]:
+        """Grid steps the object may turn ``(ccw, cw)`` with fingers ``f``, ``g`` at
+        workspace positions ``pf``, ``pg`` (thesis 5.2, fig. 5.1).
+
+        The one definition of the rotation limit: both contacts must stay inside their
+        workspaces all the way, so the room is the tighter side each way:
+        ``ccw = min(W_f - 1 - pf, W_g - 1 - pg)``, ``cw = min(pf, pg)``. Positions grow
+        counter-clockwise; arguments may be NumPy arrays (elementwise).
+        """
+        wd = self._widths
+        return (np.minimum(wd[f] - 1 - pf, wd[g] - 1 - pg) if not isinstance(pf, int)
+                else min(wd[f] - 1 - pf, wd[g] - 1 - pg),
+                np.minimum(pf, pg) if not isinstance(pf, int) else min(pf, pg))
+
+    def state_rotation_room(self, s: GaitState) -> tuple[int, int]:
+        """:meth:`rotation_room` of the two fingers holding state ``s``."""
+        f, g = s.held()
+        return self.rotation_room(f, self.position(f, s.contacts[f], s.k),
+                                  g, self.position(g, s.contacts[g], s.k))
 
     def is_legal_state(self, s: GaitState) -> bool:
         """Two fingers hold a stable grasp with both contacts inside their workspaces."""
@@ -243,8 +291,7 @@ class GaitModel:
         st, wd = self._starts, self._widths
         pf = (c[f] + k - st[f]) % n
         pg = (c[g] + k - st[g]) % n
-        ccw = min(wd[f] - 1 - pf, wd[g] - 1 - pg)
-        cw = min(pf, pg)
+        ccw, cw = self.rotation_room(f, pf, g, pg)
         if ccw > 0:
             mask[:ccw] = True
         if cw > 0:

@@ -23,6 +23,7 @@ from typing import Any
 import yaml
 
 from graspgait_env.errors import ConfigError
+from graspgait_env.resources import bundled_file, bundled_names, config_dir
 from graspgait_env.shapes import Circle, Ellipse, Polygon, Shape, Stadium
 
 __all__ = [
@@ -37,8 +38,8 @@ __all__ = [
     "positive_length",
 ]
 
-CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
-OBJECT_DIR = CONFIG_DIR / "objects"
+CONFIG_DIR = config_dir("objects").parent  # the bundled configs (graspgait_env.resources)
+OBJECT_DIR = config_dir("objects")
 
 OBJECT_DEFAULTS: dict[str, Any] = {"thickness": 0.02, "mass": 0.1, "description": ""}
 _TYPE_FIELDS: dict[str, tuple[str, ...]] = {
@@ -51,7 +52,7 @@ _TYPE_FIELDS: dict[str, tuple[str, ...]] = {
 
 def bundled_objects() -> list[str]:
     """Names of the object files shipped in ``configs/objects/`` (sorted)."""
-    return sorted(p.stem for p in OBJECT_DIR.glob("*.yaml"))
+    return bundled_names("objects")
 
 
 def read_yaml_mapping(path: Path, what: str) -> dict[str, Any]:
@@ -192,8 +193,8 @@ def resolve_object_path(name_or_path: str | Path) -> Path:
     path = Path(s)
     if s.endswith((".yaml", ".yml")) or path.exists():
         return path
-    bundled = OBJECT_DIR / f"{s}.yaml"
-    if not bundled.exists():
+    bundled = bundled_file("objects", s)
+    if bundled is None:
         raise ConfigError(
             s, "object", "no bundled object of that name and no such file",
             f"use one of {', '.join(bundled_objects())} or a path to an object YAML",

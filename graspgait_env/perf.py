@@ -1,9 +1,11 @@
 """Performance targets, measured in one process (``graspgait perf``).
 
+A composition root: it reaches across the layers (map level, physics, envs, baselines).
 Each benchmark is a function ``bench(repeat) -> list[BenchRow]`` registered in
-:data:`BENCHMARKS` with :func:`register`; :func:`run_benchmarks` runs them all in order
-and :func:`markdown_table` prints the rows. A row with a target says PASS or FAIL; a
-row without one (``passed is None``) is context (e.g. the reference loop's time).
+:data:`~graspgait_env.timing.BENCHMARKS` with :func:`~graspgait_env.timing.register`;
+:func:`run_benchmarks` runs them all in order and :func:`markdown_table` prints the
+rows. A row with a target says PASS or FAIL; a row without one (``passed is None``) is
+context (e.g. the reference loop's time).
 
 Later work adds rows by writing one more function in its own module and decorating it
 with ``@register`` (the module must be imported before :func:`run_benchmarks`; list
@@ -18,14 +20,12 @@ import importlib
 import json
 import os
 import platform
-import statistics
-import time
-from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
-from typing import Any
 
 import numpy as np
+
+from graspgait_env.timing import BENCHMARKS, BenchRow, median_time_s, register
 
 __all__ = [
     "BenchRow",
@@ -38,74 +38,19 @@ __all__ = [
     "write_json",
     "GRASP_MAP_TARGET_MS",
     "SPEEDUP_TARGET",
+    "environment_line",
 ]
 
 GRASP_MAP_TARGET_MS = 2.0  # (ms) a 180 x 180 grasp map of the thesis ellipse
 SPEEDUP_TARGET = 10.0  # vectorized grasp map vs the per-pair Python loop
 
 
-@dataclass
-class BenchRow:
-    """One line of the performance table.
-
-    Attributes
-    ----------
-    name
-        What was measured, e.g. ``"grasp map 180x180"``.
-    value
-        The measurement, in ``unit``.
-    unit
-        ``"ms"``, ``"x"`` (a ratio), ...
-    target
-        The target as text (``"< 2 ms"``), or ``""`` for a context row.
-    passed
-        True / False against the target; None for a context row.
-    detail
-        Free text: object, repeats, ...
-    """
-
-    name: str
-    value: float
-    unit: str
-    target: str = ""
-    passed: bool | None = None
-    detail: str = ""
-
-    @property
-    def verdict(self) -> str:
-        """``PASS``, ``FAIL`` or ``-``."""
-        return "-" if self.passed is None else ("PASS" if self.passed else "FAIL")
-
-
-Benchmark = Callable[[int], list[BenchRow]]
-BENCHMARKS: list[Benchmark] = []
 # Modules whose import registers more benchmarks (later issues append theirs here).
 BENCHMARK_MODULES: list[str] = [
     "baselines.bench",
     "graspgait_env.envs.bench",
     "graspgait_env.sim.perf_rows",
 ]
-
-
-def register(fn: Benchmark) -> Benchmark:
-    """Decorator: add a benchmark ``fn(repeat) -> list[BenchRow]`` to the table."""
-    if fn not in BENCHMARKS:
-        BENCHMARKS.append(fn)
-    return fn
-
-
-def median_time_s(fn: Callable[[], Any], repeat: int, warmup: int = 1) -> float:
-    """Median wall time (s) of ``fn()`` over ``repeat`` calls after ``warmup`` calls."""
-    if repeat < 1:
-        raise ValueError(f"repeat={repeat!r}: must be >= 1")
-    for _ in range(warmup):
-        fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 @register

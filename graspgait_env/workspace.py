@@ -37,7 +37,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from graspgait_env.errors import ConfigError
-from graspgait_env.objects import CONFIG_DIR, positive_length, read_yaml_mapping
+from graspgait_env.objects import positive_length, read_yaml_mapping
+from graspgait_env.resources import bundled_file, bundled_names, config_dir
 from graspgait_env.shapes import Shape
 
 __all__ = [
@@ -52,7 +53,7 @@ __all__ = [
     "DEFAULT_WORKSPACES_DEG",
 ]
 
-HAND_DIR = CONFIG_DIR / "hands"
+HAND_DIR = config_dir("hands")
 DEFAULT_WORKSPACES_DEG: tuple[tuple[float, float], ...] = ((0.0, 90.0), (120.0, 210.0),
                                                              (240.0, 330.0))
 _EPS_DEG = 1e-9  # (degrees) slack on workspace edges, so a grid angle on an edge is inside
@@ -276,7 +277,7 @@ def effective_hand(fingers: Sequence[CircularReach], shape: Shape,
 
 def bundled_hands() -> list[str]:
     """Names of the hand files shipped in ``configs/hands/``."""
-    return sorted(p.stem for p in HAND_DIR.glob("*.yaml"))
+    return bundled_names("hands")
 
 
 def load_hand(name_or_path: str | Path | Hand | None = None,
@@ -307,10 +308,11 @@ def load_hand(name_or_path: str | Path | Hand | None = None,
     s = str(name_or_path)
     path = Path(s)
     if not (s.endswith((".yaml", ".yml")) or path.exists()):
-        path = HAND_DIR / f"{s}.yaml"
-        if not path.exists():
+        bundled = bundled_file("hands", s)
+        if bundled is None:
             raise ConfigError(s, "hand", "no bundled hand of that name and no such file",
                               f"use one of {', '.join(bundled_hands())} or a hand YAML path")
+        path = bundled
     src = str(path)
     data = read_yaml_mapping(path, "hand")
     allowed = {"name", "workspaces_deg", "reach", "max_radius", "description"}

@@ -1,7 +1,7 @@
 """Speed of ``GraspGait-v0`` beside ``CartPole-v1``, measured in one process.
 
 Run from the command line (``python -m graspgait_env.envs.bench``) or through
-``graspgait perf`` (this module registers a row with :func:`graspgait_env.perf.register`
+``graspgait perf`` (this module registers a row with :func:`graspgait_env.timing.register`
 once it is listed in ``BENCHMARK_MODULES``).
 
 Both envs come from ``gymnasium.make`` (so with their default wrappers: the passive
@@ -25,7 +25,7 @@ import gymnasium as gym
 import numpy as np
 
 from graspgait_env.envs.registration import register_envs
-from graspgait_env.perf import BenchRow, register
+from graspgait_env.timing import BenchRow, register
 
 __all__ = ["bench_env_steps", "graspgait_steps_per_s", "cartpole_steps_per_s",
            "STEPS_PER_S_TARGET", "RATIO_TARGET", "bench_rows"]

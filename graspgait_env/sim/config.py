@@ -24,14 +24,15 @@ from pathlib import Path
 from typing import Any
 
 from graspgait_env.errors import ConfigError
-from graspgait_env.objects import CONFIG_DIR, read_yaml_mapping
+from graspgait_env.objects import read_yaml_mapping
+from graspgait_env.resources import config_dir
 
 __all__ = ["SimConfig", "load_sim_config", "DEFAULT_SIM_CONFIG", "LB_TO_N", "OZ_TO_N", "INCH"]
 
 INCH = 0.0254  # (m)
 LB_TO_N = 4.448222  # (N per pound-force)
 OZ_TO_N = LB_TO_N / 16.0  # (N per ounce-force)
-DEFAULT_SIM_CONFIG = CONFIG_DIR / "sim" / "default.yaml"
+DEFAULT_SIM_CONFIG = config_dir("sim") / "default.yaml"  # bundled (graspgait_env.resources)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ Targets (the physics issue):
 
 from __future__ import annotations
 
-from graspgait_env.perf import BenchRow, register
+from graspgait_env.timing import BenchRow, register
 
 __all__ = ["bench_simulation", "GAIT_WALL_TARGET_S", "CONTROLLER_SHARE_TARGET"]
 

@@ -396,16 +396,17 @@ PLAN_VERTEX_CLEARANCE_DEG = 4.0  # (degrees) keep planned contacts off polygon c
 
 def default_plan(object: str = "ellipse", mu: float = 0.7, planner: str = "optimal",
                  vertex_clearance_deg: float = PLAN_VERTEX_CLEARANCE_DEG) -> Plan:
-    """The 360° gait of ``object`` at ``mu`` by ``planner`` (baselines.registry), for the
-    physical hand: contacts stay ``vertex_clearance_deg`` away from polygon vertices.
+    """The 360° gait of ``object`` at ``mu`` by ``planner``
+    (:mod:`graspgait_env.planners.registry`), for the physical hand: contacts stay
+    ``vertex_clearance_deg`` away from polygon vertices.
 
     The thesis's point contacts may sit next to a corner; the 7.8 mm ball tip rolls along
     the contour as the object turns (about 6 mm over a 90° rotation) and rolls off it.
     Measured here: the pentagon's rule plan at 0° clearance drops in 10 of 10 perturbed
     runs; at 4° it succeeds in 10 of 10 (8° leaves too little of each edge: 4 of 10).
     """
-    from baselines.registry import run_planner
     from graspgait_env.gait import GaitModel
+    from graspgait_env.planners.registry import run_planner
 
     model = GaitModel(object, mu, vertex_clearance_deg=vertex_clearance_deg)
     res = run_planner(planner, model, None, 360.0)

@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from baselines.exact import optimal_gait
 from graspgait_env import GraspGaitInputError, Hand
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import InvalidPlanError, Plan, plan_from_states, validate_plan
+from graspgait_env.planners.exact import optimal_gait
 
 
 @pytest.fixture(scope="module")

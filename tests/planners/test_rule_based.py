@@ -8,9 +8,11 @@ import itertools
 import numpy as np
 import pytest
 
-from baselines import prototypes as P
-from baselines.exact import optimal_gait
-from baselines.rule_based import (
+from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.plan import validate_plan
+from graspgait_env.planners import prototypes as P
+from graspgait_env.planners.exact import optimal_gait
+from graspgait_env.planners.rule_based import (
     back_and_forth_gait,
     diagnose_no_gait,
     forward_gait,
@@ -18,8 +20,6 @@ from baselines.rule_based import (
     modified_search,
     rule_based,
 )
-from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.plan import validate_plan
 from graspgait_env.workspace import Hand
 
 N = 180

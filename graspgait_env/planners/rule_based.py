@@ -22,7 +22,7 @@ is the plan's regrasp count. The thesis's Table 6.1 counts rotations implicitly 
 three measures all equal the number of regrasps); ours count them explicitly, so
 ``path_length`` is about twice ``regrasps``. Zero rotations are never emitted.
 
-Coordinates (see :mod:`baselines.exact`): a finger at workspace position ``p`` at
+Coordinates (see :mod:`graspgait_env.planners.exact`): a finger at workspace position ``p`` at
 object angle ``k`` holds unwrapped contact ``x = s_f + p - k``; in the grasp map a
 rotation moves the grasp diagonally relative to the finger pair boxes, a regrasp
 horizontally (the ``x`` finger changes) or vertically (the ``y`` finger changes).
@@ -99,7 +99,9 @@ from typing import Any
 
 import numpy as np
 
-from baselines.prototypes import (
+from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.plan import plan_from_states
+from graspgait_env.planners.prototypes import (
     BandPrototype,
     BoxPrototype,
     Check,
@@ -110,9 +112,7 @@ from baselines.prototypes import (
     forward_conditions,
     inner_offset,
 )
-from baselines.result import PlannerResult
-from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.plan import plan_from_states
+from graspgait_env.planners.result import PlannerResult
 
 __all__ = [
     "forward_gait",
@@ -937,8 +937,9 @@ def diagnose_no_gait(model: GaitModel, start: GaitState | None = None,
     1. ``"no stable grasp at all (mu=0.3)"`` — the grasp map is empty;
     2. ``"stable grasps but none reachable inside the workspaces"`` — no stable pair has
        its two contacts in two fingers' workspaces at θ = 0;
-    3. ``"stuck at angle X deg"`` — the exact planner (:func:`baselines.exact.optimal_gait`)
-       proves that no gait from ``start`` (or from any of ``candidates`` starts spread
+    3. ``"stuck at angle X deg"`` — the exact planner
+       (:func:`~graspgait_env.planners.exact.optimal_gait`) proves that no gait from
+       ``start`` (or from any of ``candidates`` starts spread
        through the legal ones) turns further than X; the prototype numbers follow
        (band/box against ``w``), the reason rule-based gaits cannot help;
     4. ``"band/box smaller than the conditions need relative to w (...)"`` — a gait
@@ -947,7 +948,7 @@ def diagnose_no_gait(model: GaitModel, start: GaitState | None = None,
 
     When the forward or back-and-forth conditions hold and a gait exists, the line says so.
     """
-    from baselines.exact import optimal_gait
+    from graspgait_env.planners.exact import optimal_gait
 
     S = np.asarray(model.stable, dtype=bool)
     if not S.any():

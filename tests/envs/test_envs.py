@@ -237,8 +237,8 @@ def test_start_option_errors(ellipse_env):
 
 
 def test_success_ends_the_episode_with_the_bonus():
-    from baselines.exact import optimal_gait
     from baselines.policies import plan_actions, plan_states
+    from graspgait_env.planners.exact import optimal_gait
 
     env = make("GraspGait-v0", object="pentagon")
     env.reset(seed=2)

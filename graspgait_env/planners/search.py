@@ -21,7 +21,7 @@ Common rules
   created; the default is the exact planner's window ``[min(0, T) - 360°, max(0, T) +
   360°]`` for a turn ``T``. The state space is then finite, so a search that empties
   its queue proves that no gait exists in the window (``exhausted=True``), and its
-  verdict is comparable with :func:`baselines.exact.optimal_gait`'s.
+  verdict is comparable with :func:`graspgait_env.planners.exact.optimal_gait`'s.
 - **Counting**: ``nodes_opened`` = nodes expanded (``action_mask`` calls: thesis 5.5
   "explored as a possible path"); ``nodes_created`` = distinct states generated,
   the start and the goal included. ``max_nodes`` caps ``nodes_opened``; at the cap the
@@ -44,10 +44,10 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from baselines.result import PlannerResult
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import plan_from_states
+from graspgait_env.planners.result import PlannerResult
 
 __all__ = [
     "breadth_first",

@@ -8,7 +8,6 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines.exact import optimal_gait
 from baselines.policies import (
     PlannerPolicy,
     plan_actions,
@@ -16,22 +15,23 @@ from baselines.policies import (
     planner_start,
     rebased_model,
 )
-from baselines.result import PlannerResult
 from graspgait_env.envs import register_envs
 from graspgait_env.envs.map_env import GraspGaitEnv
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.objects import bundled_objects
+from graspgait_env.planners.exact import optimal_gait
+from graspgait_env.planners.result import PlannerResult
 
 register_envs()
 ENV = "graspgait_env.envs:GraspGait-v0"
 
 # (module, function): the planners with the shared signature; those not written yet skip
-PLANNERS = [("baselines.exact", "optimal_gait"),
-            ("baselines.rule_based", "forward_gait"),
-            ("baselines.rule_based", "back_and_forth_gait"),
-            ("baselines.rule_based", "modified_search"),
-            ("baselines.rule_based", "rule_based"),
-            ("baselines.search", "best_first")]
+PLANNERS = [("graspgait_env.planners.exact", "optimal_gait"),
+            ("graspgait_env.planners.rule_based", "forward_gait"),
+            ("graspgait_env.planners.rule_based", "back_and_forth_gait"),
+            ("graspgait_env.planners.rule_based", "modified_search"),
+            ("graspgait_env.planners.rule_based", "rule_based"),
+            ("graspgait_env.planners.search", "best_first")]
 
 
 def _planner(mod: str, fn: str):

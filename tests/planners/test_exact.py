@@ -7,11 +7,11 @@ import pytest
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
-from baselines.exact import optimal_gait
-from baselines.search import best_first, breadth_first, depth_first
 from graspgait_env.gait import GaitModel
 from graspgait_env.objects import bundled_objects
 from graspgait_env.plan import validate_plan
+from graspgait_env.planners.exact import optimal_gait
+from graspgait_env.planners.search import best_first, breadth_first, depth_first
 from graspgait_env.shapes import Polygon
 
 N = 36  # 10-degree grid: the thesis hand keeps 10 grid angles per 90-degree workspace

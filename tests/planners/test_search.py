@@ -5,17 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from baselines.exact import optimal_gait
-from baselines.search import (
+from graspgait_env import GraspGaitInputError
+from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.plan import validate_plan
+from graspgait_env.planners.exact import optimal_gait
+from graspgait_env.planners.search import (
     _Graph,
     best_first,
     best_first_metric,
     breadth_first,
     depth_first,
 )
-from graspgait_env import GraspGaitInputError
-from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.plan import validate_plan
 
 OBJECTS = ["circle", "pentagon", "ellipse", "hexagon", "square"]
 PLANNERS = [breadth_first, depth_first, best_first]

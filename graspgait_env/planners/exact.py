@@ -30,9 +30,9 @@ import time
 
 import numpy as np
 
-from baselines.result import PlannerResult
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import plan_from_states
+from graspgait_env.planners.result import PlannerResult
 
 __all__ = ["optimal_gait", "PAIRS"]
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 
-from baselines.result import PlannerResult
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.planners.result import PlannerResult
 
 __all__ = ["PLANNERS", "get_planner", "run_planner", "default_start", "Planner"]
 
@@ -19,14 +19,15 @@ Planner = Callable[..., PlannerResult]
 
 # name -> "module:function" (imported on first use)
 PLANNERS: dict[str, str] = {
-    "bfs": "baselines.search:breadth_first",  # thesis 5.3
-    "dfs": "baselines.search:depth_first",  # thesis 5.4
-    "best-first": "baselines.search:best_first",  # thesis 5.5
-    "forward": "baselines.rule_based:forward_gait",  # thesis 6.3.1
-    "back-and-forth": "baselines.rule_based:back_and_forth_gait",  # thesis 6.3.2
-    "modified": "baselines.rule_based:modified_search",  # thesis 6.4
-    "rule": "baselines.rule_based:rule_based",  # thesis 6.5, Table 6.1
-    "optimal": "baselines.exact:optimal_gait",  # beyond the thesis: exact minimum regrasps
+    "bfs": "graspgait_env.planners.search:breadth_first",  # thesis 5.3
+    "dfs": "graspgait_env.planners.search:depth_first",  # thesis 5.4
+    "best-first": "graspgait_env.planners.search:best_first",  # thesis 5.5
+    "forward": "graspgait_env.planners.rule_based:forward_gait",  # thesis 6.3.1
+    "back-and-forth": "graspgait_env.planners.rule_based:back_and_forth_gait",  # thesis 6.3.2
+    "modified": "graspgait_env.planners.rule_based:modified_search",  # thesis 6.4
+    "rule": "graspgait_env.planners.rule_based:rule_based",  # thesis 6.5, Table 6.1
+    # beyond the thesis: exact minimum regrasps
+    "optimal": "graspgait_env.planners.exact:optimal_gait",
 }
 
 # planners that choose their own start when given none
@@ -49,7 +50,7 @@ def default_start(model: GaitModel, candidates: int = 24) -> GaitState:
     finds a gait; if none does, the first legal start. Raises when there is no legal
     start at all (no stable grasp inside the workspaces).
     """
-    from baselines.exact import optimal_gait
+    from graspgait_env.planners.exact import optimal_gait
 
     starts = model.start_states()
     if not starts:
