@@ -1,4 +1,4 @@
-"""The ``graspgait`` command line (DESIGN.md, "Command line").
+"""The ``graspgait`` command line (docs/cli.md).
 
 ::
 
@@ -298,7 +298,7 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                    help="keep contacts DEG degrees off polygon vertices (default 0, the "
                    "thesis's point contacts; 4 for plans run by `graspgait simulate`: a ball "
                    "tip rolls off corners)")
-    p.add_argument("--json", metavar="FILE", help="write the plan JSON (DESIGN.md)")
+    p.add_argument("--json", metavar="FILE", help="write the plan JSON (docs/formats.md)")
     p.add_argument("--motion", metavar="FILE", help="write the thesis's motion_file (7.4.1)")
     p.add_argument("--png", metavar="FILE", help="draw the gait over the maps")
     p.set_defaults(func=_cmd_plan)
@@ -398,7 +398,7 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:
 
 
 # --- registry -------------------------------------------------------------------------
-# Later subcommands (plan, bench, simulate, train; DESIGN.md) are added HERE: write
+# Later subcommands (plan, bench, simulate, train) are added HERE: write
 # `_cmd_X(args) -> int` and `_add_X(sub)` as above and append `_add_X` below. Register
 # only commands that work.
 SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [

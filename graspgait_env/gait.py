@@ -18,8 +18,8 @@ of each finger, ``-1`` for the free finger. Exactly two fingers hold the object.
 In the thesis's terms (5.2) ``X = [theta, x, y]`` with the fingers implied by the
 workspaces; we name the fingers explicitly since the action space does.
 
-Moves (DESIGN.md)
------------------
+Moves (docs/conventions.md)
+---------------------------
 - **rotate** by ``±j`` grid steps: both contacts stay inside their fingers' workspaces
   all the way (thesis 5.2, fig. 5.1; either direction).
 - **regrasp**: the free finger is placed at a grid contact reachable now (inside its

@@ -1,4 +1,4 @@
-"""Object files: load and validate the object YAML of DESIGN.md.
+"""Object files: load and validate the object YAML of docs/formats.md.
 
 Format (``configs/objects/NAME.yaml`` or any path)::
 

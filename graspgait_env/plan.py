@@ -1,4 +1,4 @@
-"""Gait plans: the JSON of DESIGN.md, the thesis's ``motion_file`` (7.4.1) and a validator.
+"""Gait plans: the JSON of docs/formats.md, the thesis's ``motion_file`` (7.4.1) and a validator.
 
 A plan is a list of steps in the object frame::
 
@@ -58,7 +58,7 @@ _TOL_DEG = 1e-6  # (degrees) slack on workspace edges when replaying a plan
 
 @dataclass
 class Plan:
-    """A gait plan (DESIGN.md). ``steps`` use finger numbers 1..3 as strings, degrees."""
+    """A gait plan (docs/formats.md). ``steps`` use finger numbers 1..3 as strings, degrees."""
 
     object: str
     mu: float
@@ -68,7 +68,7 @@ class Plan:
 
     # ---------------------------------------------------------------- JSON
     def to_dict(self) -> dict[str, Any]:
-        """The plan as the JSON-ready mapping of DESIGN.md."""
+        """The plan as the JSON-ready mapping of docs/formats.md."""
         return {"object": self.object, "mu": self.mu, "workspaces_deg": self.workspaces_deg,
                 "steps": self.steps, "stats": self.stats}
 
@@ -87,7 +87,8 @@ class Plan:
             raise GraspGaitInputError(f"{source}: a plan must be a JSON object")
         for key in ("object", "mu", "workspaces_deg", "steps"):
             if key not in d:
-                raise GraspGaitInputError(f"{source}: field '{key}' missing; add it (DESIGN.md)")
+                raise GraspGaitInputError(
+                    f"{source}: field '{key}' missing; add it (see docs/formats.md)")
         if not isinstance(d["steps"], list) or not d["steps"]:
             raise GraspGaitInputError(f"{source}: field 'steps' must be a non-empty list")
         mu = d["mu"]

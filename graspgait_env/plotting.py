@@ -4,7 +4,7 @@ Every function draws on a :class:`matplotlib.figure.Figure` built directly (no
 ``pyplot``), so nothing here touches pyplot's global figure list or the interactive
 backend: figures are garbage-collected like any object and saving works headless.
 
-Conventions (as in the thesis and DESIGN.md)
+Conventions (as in the thesis and docs/conventions.md)
 --------------------------------------------
 - Angles in degrees, counter-clockwise positive.
 - Grasp map axes: horizontal ``phi_i`` (finger i), vertical ``phi_j`` (finger j), both

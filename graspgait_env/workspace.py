@@ -162,7 +162,7 @@ class Hand:
         raise ValueError(f"no finger pair box ({finger_x}, {finger_y}) on hand {self.name!r}")
 
     def to_dict(self) -> dict[str, Any]:
-        """The hand as the ``workspaces_deg`` list of the plan JSON (DESIGN.md)."""
+        """The hand as the ``workspaces_deg`` list of the plan JSON (docs/formats.md)."""
         return {"name": self.name, "workspaces_deg": [list(w) for w in self.workspaces_deg]}
 
 

@@ -260,7 +260,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def __init__(
         self,
-        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (DESIGN.md OBJECT)
+        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (docs/cli.md OBJECT)
         mu: float = 0.7,
         hand: str | Hand | None = None,
         turn_deg: float = 360.0,

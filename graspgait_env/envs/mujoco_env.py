@@ -39,7 +39,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
     tips, the object on a table). The env keeps the map-level :class:`GaitState` as the
     **commanded state** (the plan so far); each legal action is turned into a plan step
     (``{"op": "rotate", "delta": deg}`` or ``{"op": "regrasp", "contacts": {...}}``,
-    DESIGN.md) and executed by :class:`~graspgait_env.sim.executor.GaitExecutor`, the
+    docs/formats.md) and executed by :class:`~graspgait_env.sim.executor.GaitExecutor`, the
     thesis controller (trajectory planner, PD servo, grip and friction cone check,
     object localizer; thesis 7.3-7.4). Physics is deterministic: an episode is a pure
     function of the start grasp, the pose perturbation and the actions.
@@ -155,7 +155,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     def __init__(
         self,
-        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (DESIGN.md OBJECT)
+        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (docs/cli.md OBJECT)
         mu: float = 0.7,
         hand: str | Hand | None = None,
         turn_deg: float = 360.0,
@@ -210,7 +210,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         return {str(f + 1): self.model.contact_deg(c) for f, c in enumerate(contacts) if c >= 0}
 
     def _plan_step(self, s: GaitState, action: int) -> dict[str, Any]:
-        """The DESIGN.md plan step of a legal ``action`` in state ``s``."""
+        """The plan step (docs/formats.md) of a legal ``action`` in state ``s``."""
         m = self.model.decode(s, action)
         if m.kind == ROTATE:
             return {"op": "rotate", "delta": m.delta * self._step_deg}

@@ -29,7 +29,7 @@ Common rules
 - **Plan**: one step per move (rotations are not merged), so ``path_length`` = number
   of moves = ``len(plan.steps) - 1``.
 
-Rotation goes either way (DESIGN.md): the thesis discretizes CCW rotations only
+Rotation goes either way (docs/conventions.md): the thesis discretizes CCW rotations only
 (5.2, Δθ = 2°); here every legal rotation in both directions is a branch.
 """
 

@@ -670,7 +670,7 @@ class GaitExecutor:
         return out
 
     def execute(self, step: dict) -> StepReport:
-        """Execute one plan step (``grasp``, ``rotate`` or ``regrasp``, DESIGN.md)."""
+        """Execute one plan step (``grasp``, ``rotate`` or ``regrasp``, docs/formats.md)."""
         op = step.get("op")
         if op == "grasp":
             return self.reset(step["contacts"])

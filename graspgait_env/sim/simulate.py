@@ -69,7 +69,7 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
     Parameters
     ----------
     plan
-        A gait plan (DESIGN.md JSON, :meth:`Plan.load`); its object is a bundled name
+        A gait plan (the JSON of docs/formats.md, :meth:`Plan.load`); its object is a bundled name
         or a YAML path, its ``mu`` the friction the planner assumed (the friction
         cone check uses it; the contacts' true friction is ``config.finger_mu``).
     video
@@ -109,7 +109,7 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
         raise GraspGaitInputError(f"plan: expected a Plan (Plan.load(path)), got "
                                   f"{type(plan).__name__}")
     if not plan.steps or plan.steps[0].get("op") != "grasp":
-        raise GraspGaitInputError("plan: the first step must be a 'grasp' (DESIGN.md)")
+        raise GraspGaitInputError("plan: the first step must be a 'grasp' (docs/formats.md)")
     rng = np.random.default_rng(seed)
     if isinstance(pose_perturbation, str):
         if pose_perturbation != "random":

@@ -1,4 +1,4 @@
-"""The ``graspgait`` command line: outputs, exit codes, one-line errors (DESIGN.md)."""
+"""The ``graspgait`` command line: outputs, exit codes, one-line errors (docs/cli.md)."""
 
 from __future__ import annotations
 

@@ -172,7 +172,7 @@ def test_bundled_nominal_vertex_contacts_never_stable(name):
     pentagon at 18°, 90°, 162°, ...; the regular hexagon at 0°, 60°, ...). Their YAML
     coordinates carry 6 decimals, which moves the vertex angles by up to ~4e-4°. A grid
     contact within 1e-3° of a vertex is a vertex contact for any practical purpose and
-    must never be part of a stable grasp (DESIGN.md)."""
+    must never be part of a stable grasp (docs/conventions.md)."""
     shape = load_object(name)
     phi = grid_angles_deg(N)
     dist = np.abs((phi[:, None] - shape.vertex_angles_deg + 180.0) % 360.0 - 180.0).min(1)

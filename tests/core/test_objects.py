@@ -1,4 +1,4 @@
-"""Object files (DESIGN.md "File formats"): bundled objects load; malformed ones are refused
+"""Object files (docs/formats.md): bundled objects load; malformed ones are refused
 with a one-line ConfigError that names the offending field."""
 
 from __future__ import annotations
