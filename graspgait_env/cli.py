@@ -35,6 +35,13 @@ __all__ = ["main", "build_parser", "SUBCOMMANDS"]
 PROG = "graspgait"
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line usage errors: ``graspgait map: error: ...; see --help``."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}; see `{self.prog} --help`\n")
+
+
 def _input_error(flag: str, exc: ValueError) -> GraspGaitInputError:
     """A library ValueError about a numeric argument, as a user error naming the flag."""
     return GraspGaitInputError(f"{flag}: {exc}")
@@ -64,6 +71,35 @@ def _check_theta(theta: float) -> float:
     return float(theta)
 
 
+def _check_outputs(args: argparse.Namespace, specs: dict[str, tuple[str, ...] | None]) -> None:
+    """Check every output path given (``{dest: suffixes}``) before any work."""
+    from graspgait_env.outputs import check_output_path
+
+    for dest, suffixes in specs.items():
+        path = getattr(args, dest, None)
+        if path is not None:
+            check_output_path(f"--{dest}", path, suffixes)
+
+
+def _figure_suffixes() -> tuple[str, ...]:
+    from graspgait_env.outputs import figure_suffixes
+
+    return figure_suffixes()
+
+
+def _object_help() -> str:
+    from graspgait_env.objects import bundled_objects
+
+    return f"a bundled object ({', '.join(bundled_objects())}) or an object YAML path"
+
+
+def _hand_help() -> str:
+    from graspgait_env.workspace import bundled_hands
+
+    return (f"a bundled hand ({', '.join(bundled_hands())}) or a hand YAML path "
+            "(default: thesis, fig. 4.1)")
+
+
 def _write_output(flag: str, path: str, write: Callable[[], object]) -> None:
     """Run a writer; an unwritable path is the user's to fix (exit 2), not a crash."""
     try:
@@ -85,6 +121,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
     mu = _check_mu(args.mu)
     n = _check_n(args.n)
     theta = _check_theta(args.theta)
+    _check_outputs(args, {"png": _figure_suffixes() if args.png else None, "npy": (".npy",)})
     shape = load_object(args.object)
     hand, max_radius = load_hand(args.hand, shape)
     gm = grasp_map(shape, mu, n, max_radius=max_radius)
@@ -115,14 +152,14 @@ def _add_map(sub: argparse._SubParsersAction) -> None:
                        "summary, optionally save the map (.npy) and a figure (.png): object "
                        "with normals, grasp map, extended map with the hand's finger pair "
                        "boxes at object angle THETA (thesis figs. 3.1, 4.5, 6.1).")
-    p.add_argument("object", metavar="OBJECT", help="bundled object name or object YAML path")
+    p.add_argument("object", metavar="OBJECT", help=_object_help())
     p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
     p.add_argument("--n", type=int, default=180,
                    help="contacts on the contour (default 180: 2 deg)")
     p.add_argument("--theta", type=float, default=0.0,
                    help="object angle (deg) at which the finger pair boxes are drawn")
     p.add_argument("--hand", default=None,
-                   help="bundled hand name or hand YAML path (default: the thesis hand)")
+                   help=_hand_help())
     p.add_argument("--png", metavar="FILE", help="write the figure here")
     p.add_argument("--npy", metavar="FILE", help="write the boolean map here (np.save)")
     p.set_defaults(func=_cmd_map)
@@ -137,6 +174,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
     n = _check_n(args.n)
     png = args.png or f"sweep_{args.kind}.png"
+    from graspgait_env.outputs import check_output_path
+
+    check_output_path("--png", png, _figure_suffixes())
     print(f"{args.kind} sweep, n={n}: fraction of stable cells")
     print("object    " + "".join(f"  mu={mu:<5g}" for mu in SWEEP_MUS))
     for label, shape in sweep_objects(args.kind):
@@ -167,6 +207,7 @@ def _cmd_perf(args: argparse.Namespace) -> int:
 
     if args.repeat < 1:
         raise GraspGaitInputError(f"--repeat {args.repeat}: must be >= 1, e.g. 100")
+    _check_outputs(args, {"json": (".json",)})
     rows = perf.run_benchmarks(args.repeat)
     print(perf.environment_line())
     print()
@@ -231,7 +272,19 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if not (math.isfinite(clearance) and 0 <= clearance < 90):
         raise GraspGaitInputError(f"--vertex-clearance {clearance!r}: give degrees in "
                                   "[0, 90), e.g. 4 for plans run on the MuJoCo hand")
+    _check_outputs(args, {"json": (".json",), "motion": ("", ".txt"),
+                          "png": _figure_suffixes() if args.png else None})
+    from graspgait_env.gait import MAX_PLAN_N
+
+    if n > MAX_PLAN_N:
+        raise GraspGaitInputError(f"--n {n}: planning takes at most {MAX_PLAN_N} grid points "
+                                  f"(a {360 / MAX_PLAN_N:g}-degree grid; about 3 GB at n=1800); "
+                                  "give e.g. 180")
     model = GaitModel(args.object, mu, hand=args.hand, n=n, vertex_clearance_deg=clearance)
+    try:
+        model.turn_steps(args.turn)  # refuses a turn beyond what the planners can hold
+    except GraspGaitInputError as exc:
+        raise GraspGaitInputError(f"--turn: {exc}") from None
     start = _parse_start(args.start, model)
     res = run_planner(args.planner, model, start, args.turn)
     print(model.shape.describe())
@@ -281,7 +334,7 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                        description="Plan a gait turning OBJECT by TURN degrees with one of "
                        "the thesis's planners or the exact optimum; exit 0 with a plan, 1 "
                        "when no gait exists (with a diagnosis), 2 for bad input.")
-    p.add_argument("object", metavar="OBJECT", help="bundled object name or object YAML path")
+    p.add_argument("object", metavar="OBJECT", help=_object_help())
     p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
     p.add_argument("--planner", required=True, choices=list(PLANNERS), metavar="P",
                    help=f"one of: {', '.join(PLANNERS)}")
@@ -293,7 +346,7 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                    help="turn in degrees, counter-clockwise positive (default 360)")
     p.add_argument("--n", type=int, default=180, help="grid: contacts and rotation steps "
                    "of 360/n deg (default 180)")
-    p.add_argument("--hand", default=None, help="bundled hand name or hand YAML path")
+    p.add_argument("--hand", default=None, help=_hand_help())
     p.add_argument("--vertex-clearance", type=float, default=0.0, metavar="DEG",
                    help="keep contacts DEG degrees off polygon vertices (default 0, the "
                    "thesis's point contacts; 4 for plans run by `graspgait simulate`: a ball "
@@ -328,6 +381,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     objects = _csv_list("--objects", args.objects, str)
     if args.starts < 1:
         raise GraspGaitInputError(f"--starts {args.starts}: must be >= 1, e.g. 10")
+    _check_outputs(args, {"csv": (".csv",), "json": (".json",), "md": (".md",)})
     from graspgait_env.objects import load_object
 
     for o in objects:
@@ -373,6 +427,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     # imported here so that MUJOCO_GL=egl is set (graspgait_env.sim) before MuJoCo loads
     from graspgait_env.sim.simulate import simulate_command
 
+    _check_outputs(args, {"json": (".json",), "video": (".mp4",)})
     return simulate_command(args.plan, video=args.video, seed=args.seed, perturb=args.perturb,
                             config=args.config, json_out=args.json, progress=not args.quiet)
 
@@ -414,11 +469,17 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
 def build_parser() -> argparse.ArgumentParser:
     """The ``graspgait`` argument parser with every registered subcommand."""
     from graspgait_env import __version__
+    from graspgait_env.objects import bundled_objects
+    from graspgait_env.workspace import bundled_hands
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog=PROG,
         description="Grasp gaits for planar object manipulation (Leveroni, MIT 1997): "
-        "grasp maps, workspace maps, gaits.",
+        "grasp maps, workspace maps, gaits, and their execution on a simulated hand.",
+        epilog=f"bundled objects (OBJECT): {', '.join(bundled_objects())}; or the path of an "
+        "object YAML (docs/formats.md). "
+        f"Bundled hands (--hand): {', '.join(bundled_hands())}; or a hand YAML path. "
+        "Exit status: 0 success, 1 no gait exists or the hand fails, 2 bad input.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)

@@ -52,10 +52,18 @@ from graspgait_env.objects import load_object
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand, load_hand
 
-__all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP", "workspace_grid"]
+__all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP", "workspace_grid",
+           "MAX_PLAN_N", "MAX_TURN_STEPS"]
 
 ROTATE = "rotate"
 REGRASP = "regrasp"
+
+# Bounds on what a plan may ask for, so that no planner allocates more than this machine
+# holds. Measured peaks (2-core, 24 GiB machine): the exact planner at n = 720 turning
+# 900 deg (1800 grid steps) 1.1 GB, at n = 180 turning 3600 deg (1800 steps) 0.5 GB,
+# and at 18000 steps 24 GB; best-first and the exact planner at n = 1800 about 3.1 GB.
+MAX_PLAN_N = 720  # (grid points) a 0.5-degree grid
+MAX_TURN_STEPS = 1800  # (grid steps) |turn_deg| * n / 360: ten turns on the 2-degree grid
 
 
 def workspace_grid(workspaces_deg, n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -154,8 +162,13 @@ class GaitModel:
     def __init__(self, shape: Shape | str, mu: float, hand: Hand | str | None = None,
                  n: int = 180, max_radius: float | None = None,
                  vertex_clearance_deg: float = 0.0) -> None:
-        self.shape = load_object(shape)
         self.n = check_n(n)
+        if self.n > MAX_PLAN_N:
+            raise GraspGaitInputError(
+                f"n={n!r}: the gait model plans on at most {MAX_PLAN_N} grid points (a "
+                f"{360 / MAX_PLAN_N:g}-degree grid; planners need about 3 GB at n=1800); "
+                "give e.g. 180")
+        self.shape = load_object(shape)
         self.hand, hand_cap = load_hand(hand, self.shape)
         if self.hand.n_fingers != 3:
             raise GraspGaitInputError(
@@ -351,8 +364,23 @@ class GaitModel:
         return [(int(a), self.apply(s, int(a))) for a in np.flatnonzero(self.action_mask(s))]
 
     def turn_steps(self, turn_deg: float) -> int:
-        """The requested turn in grid steps (rounded away from zero to the grid)."""
+        """The requested turn in grid steps (rounded away from zero to the grid).
+
+        Raises
+        ------
+        GraspGaitInputError
+            ``turn_deg`` not finite, or more than :data:`MAX_TURN_STEPS` grid steps
+            (3600 degrees on the 2-degree grid): planners allocate in proportion to it.
+        """
+        if not math.isfinite(turn_deg):
+            raise GraspGaitInputError(f"turn_deg={turn_deg!r}: give a finite angle in degrees, "
+                                      "e.g. 360")
         x = turn_deg / self.step_deg
+        if abs(x) > MAX_TURN_STEPS + 1e-9:
+            raise GraspGaitInputError(
+                f"turn_deg={turn_deg:g}: at most {MAX_TURN_STEPS} grid steps "
+                f"({MAX_TURN_STEPS * self.step_deg:g} deg at n={self.n}); planners allocate "
+                "in proportion to the turn; give e.g. 360")
         return int(math.ceil(x - 1e-9)) if x >= 0 else int(math.floor(x + 1e-9))
 
     def describe_state(self, s: GaitState) -> str:

@@ -56,6 +56,12 @@ __all__ = [
 _TOL_DEG = 1e-6  # (degrees) slack on workspace edges when replaying a plan
 
 
+def _is_number(x: Any) -> bool:
+    """A finite JSON number (not a bool, not a string)."""
+    return (not isinstance(x, bool) and isinstance(x, (int, float))
+            and math.isfinite(float(x)))
+
+
 @dataclass
 class Plan:
     """A gait plan (docs/formats.md). ``steps`` use finger numbers 1..3 as strings, degrees."""
@@ -82,20 +88,84 @@ class Plan:
 
     @classmethod
     def from_dict(cls, d: Any, source: str = "<plan>") -> Plan:
-        """Read a plan mapping; refuses missing or mistyped top-level fields."""
+        """Read a plan mapping, checking every field's type before any use.
+
+        Checked: the top-level keys (``object``, ``mu``, ``workspaces_deg``, ``steps``,
+        optional ``stats``; others are refused), ``mu`` a finite number > 0,
+        ``workspaces_deg`` a list of ``[lo, hi]`` pairs of finite degrees, and each
+        step: ``op`` one of grasp/rotate/regrasp, the first a grasp and only the first;
+        a rotate has a finite non-zero ``delta`` (degrees); a grasp or regrasp has
+        ``contacts`` mapping two distinct finger numbers (``"1"`` .. ``"N"``, N the
+        number of workspaces) to finite angles (degrees). Whether the plan obeys the
+        gait rules is :func:`validate_plan`'s question, not this one's.
+
+        Raises
+        ------
+        GraspGaitInputError
+            One line naming the source, the field (``steps[3].contacts.2``), the bad
+            value and the fix.
+        """
+        def bad(field_: str, value: Any, want: str) -> GraspGaitInputError:
+            return GraspGaitInputError(
+                f"{source}: field '{field_}'={value!r}: {want} (see docs/formats.md)")
+
         if not isinstance(d, dict):
-            raise GraspGaitInputError(f"{source}: a plan must be a JSON object")
-        for key in ("object", "mu", "workspaces_deg", "steps"):
+            raise GraspGaitInputError(f"{source}: a plan must be a JSON object "
+                                      "(see docs/formats.md)")
+        known = ("object", "mu", "workspaces_deg", "steps", "stats")
+        for key in d:
+            if key not in known:
+                raise bad(str(key), d[key], f"unknown field; use only {', '.join(known)}")
+        for key in known[:4]:
             if key not in d:
                 raise GraspGaitInputError(
                     f"{source}: field '{key}' missing; add it (see docs/formats.md)")
-        if not isinstance(d["steps"], list) or not d["steps"]:
-            raise GraspGaitInputError(f"{source}: field 'steps' must be a non-empty list")
+        if not isinstance(d["object"], str) or not d["object"].strip():
+            raise bad("object", d["object"], "give a bundled object name or an object YAML path")
         mu = d["mu"]
-        if isinstance(mu, bool) or not isinstance(mu, (int, float)) or not mu > 0:
-            raise GraspGaitInputError(f"{source}: field 'mu'={mu!r} must be a number > 0")
-        return cls(str(d["object"]), float(mu), [list(map(float, w)) for w in d["workspaces_deg"]],
-                   list(d["steps"]), dict(d.get("stats", {})))
+        if not _is_number(mu) or not mu > 0:
+            raise bad("mu", mu, "must be a finite number > 0, e.g. 0.7")
+        ws = d["workspaces_deg"]
+        if not isinstance(ws, list) or not ws:
+            raise bad("workspaces_deg", ws, "give one [lo, hi] pair of degrees per finger")
+        for f, w in enumerate(ws):
+            if not (isinstance(w, list) and len(w) == 2 and all(_is_number(x) for x in w)):
+                raise bad(f"workspaces_deg[{f}]", w, "give [lo, hi] in degrees, e.g. [0, 90]")
+        fingers = {str(f) for f in range(1, len(ws) + 1)}
+        steps = d["steps"]
+        if not isinstance(steps, list) or not steps:
+            raise bad("steps", steps, "must be a non-empty list of steps")
+        for i, st in enumerate(steps):
+            where = f"steps[{i}]"
+            if not isinstance(st, dict):
+                raise bad(where, st, "each step must be an object with an 'op'")
+            op = st.get("op")
+            if op not in ("grasp", "rotate", "regrasp"):
+                raise bad(f"{where}.op", op, "use grasp, rotate or regrasp")
+            if (op == "grasp") != (i == 0):
+                raise bad(f"{where}.op", op, "the first step, and only the first, is a grasp")
+            if op == "rotate":
+                delta = st.get("delta")
+                if not _is_number(delta) or delta == 0:
+                    raise bad(f"{where}.delta", delta,
+                              "give a finite non-zero rotation in degrees, CCW positive")
+                continue
+            contacts = st.get("contacts")
+            if not isinstance(contacts, dict) or len(contacts) != 2:
+                raise bad(f"{where}.contacts", contacts,
+                          'give two fingers and their contact angles, e.g. {"1": 50, "3": 270}')
+            for f, phi in contacts.items():
+                if f not in fingers:
+                    raise bad(f"{where}.contacts", f,
+                              f"finger numbers are {', '.join(sorted(fingers))} (as strings)")
+                if not _is_number(phi):
+                    raise bad(f"{where}.contacts.{f}", phi,
+                              "give the contact angle in degrees (object frame), e.g. 50.0")
+        stats = d.get("stats", {})
+        if not isinstance(stats, dict):
+            raise bad("stats", stats, "must be an object (or be left out)")
+        return cls(d["object"], float(mu), [[float(x) for x in w] for w in ws],
+                   [dict(st) for st in steps], dict(stats))
 
     @classmethod
     def load(cls, path: str | Path) -> Plan:

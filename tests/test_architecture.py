@@ -1,0 +1,49 @@
+"""Architecture contracts: one-way layers and a pure-NumPy core (import-linter).
+
+The contracts live in ``pyproject.toml`` (``[tool.importlinter]``); this test runs
+``lint-imports`` on them and checks that every top-level module of the core package is
+named in the layers contract, so a new module cannot slip past it.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import tomllib
+
+import graspgait_env
+
+ROOT = Path(__file__).resolve().parents[1]
+COMPOSITION_ROOTS = {"cli", "perf"}  # may reach across the layers
+
+
+def _contracts() -> list[dict]:
+    with open(ROOT / "pyproject.toml", "rb") as fh:
+        return tomllib.load(fh)["tool"]["importlinter"]["contracts"]
+
+
+def test_import_contracts_are_kept() -> None:
+    exe = Path(sys.executable).with_name("lint-imports")
+    out = subprocess.run([str(exe), "--config", str(ROOT / "pyproject.toml")], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-2000:]
+    assert "0 broken" in out.stdout
+
+
+def test_every_core_module_is_in_a_layer() -> None:
+    layers = next(c for c in _contracts() if c["type"] == "layers")["layers"]
+    named = {m.strip() for layer in layers for m in layer.replace("|", ":").split(":")}
+    pkg = Path(graspgait_env.__file__).parent
+    modules = {p.stem for p in pkg.glob("*.py")} - {"__init__"} - COMPOSITION_ROOTS
+    missing = sorted(f"graspgait_env.{m}" for m in modules if f"graspgait_env.{m}" not in named)
+    assert not missing, f"add {missing} to a layer of the import-linter contract"
+    for sub in ("planners", "sim", "envs"):
+        assert f"graspgait_env.{sub}" in named
+
+
+def test_the_layers_run_in_the_documented_order() -> None:
+    layers = next(c for c in _contracts() if c["type"] == "layers")["layers"]
+    assert layers[:5] == ["agents", "baselines", "graspgait_env.envs", "graspgait_env.sim",
+                          "graspgait_env.planners"]
