@@ -10,20 +10,31 @@ export MUJOCO_GL ?= egl
 .PHONY: demo test test-all lint perf bench clean
 
 $(STAMP): pyproject.toml
+	@echo "==> creating the virtual environment $(VENV)"
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@echo "==> installing graspgait_env and its dependencies into $(VENV) (NumPy, MuJoCo,"
+	@echo "    Gymnasium, the CPU wheel of torch, stable-baselines3; about a minute on a fresh machine)"
+	$(BIN)/python -m pip install --progress-bar on -e '.[dev]'
 	touch $(STAMP)
+	@echo "==> $(VENV) is ready"
 
 demo: $(STAMP)
 	mkdir -p out
+	@echo "==> grasp maps of the ellipse (finger pair boxes at theta = 30 deg) and the pentagon"
 	$(BIN)/graspgait map ellipse --mu 0.7 --theta 30 --png out/ellipse_map.png --npy out/ellipse_map.npy
 	$(BIN)/graspgait map pentagon --mu 0.7 --png out/pentagon_map.png
+	@echo "==> stable fraction of the grasp map against eccentricity and friction (thesis figs. 3.8-3.9)"
 	$(BIN)/graspgait sweep eccentricity --png out/sweep_eccentricity.png
+	@echo "==> the fewest-regrasp gait of the pentagon from the thesis's start (fig. 4.6), and the rule-based one"
 	$(BIN)/graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270 \
 		--json out/pentagon_plan.json --motion out/pentagon_motion.txt --png out/pentagon_gait.png
-	$(BIN)/graspgait perf
-	@echo "demo figures written to out/"
+	$(BIN)/graspgait plan pentagon --mu 0.7 --planner rule \
+		--json out/pentagon_rule_plan.json --png out/pentagon_rule_gait.png
+	@echo
+	@echo "demo: made these files in $(CURDIR)/out:"
+	@ls -1 out | sed 's/^/  out\//'
+	@echo "(performance targets: make perf)"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
