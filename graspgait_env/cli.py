@@ -299,6 +299,11 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if v is not None:  # a planner bug, never the user's input
         raise RuntimeError(f"planner {args.planner} returned an invalid plan: "
                            f"{InvalidPlanError(v)}")
+    from graspgait_env.objects import bundled_objects
+
+    if args.object not in bundled_objects():
+        # an object file: the plan names the file, so `graspgait simulate` finds the shape
+        res.plan.object = args.object
     res.plan.stats.update({"planner": res.planner, "nodes_opened": res.nodes_opened,
                            "regrasps": res.regrasps, "rotation_deg": res.rotation_deg,
                            "path_length": res.path_length})

@@ -4,17 +4,23 @@ Every function draws on a :class:`matplotlib.figure.Figure` built directly (no
 ``pyplot``), so nothing here touches pyplot's global figure list or the interactive
 backend: figures are garbage-collected like any object and saving works headless.
 
+Every figure reads without the thesis: its axes say in words what they measure, and its
+legend says what a dark cell, a box outline and each colour of a gait mean.
+
 Conventions (as in the thesis and docs/conventions.md)
---------------------------------------------
+------------------------------------------------------
 - Angles in degrees, counter-clockwise positive.
-- Grasp map axes: horizontal ``phi_i`` (finger i), vertical ``phi_j`` (finger j), both
-  in the object frame ``f``; the origin of the map is at the bottom left
-  (``imshow(..., origin="lower")``), stable cells shaded.
+- Grasp map axes: horizontal ``phi_i`` (the contact of finger i), vertical ``phi_j``
+  (the contact of finger j), both in the object frame ``f``; the origin of the map is at
+  the bottom left (``imshow(..., origin="lower")``). A dark cell is a force-closure grasp
+  at the map's friction ``mu`` (:data:`STABLE_LABEL`).
 - Extended map (thesis fig. 3.3): the map tiled over [0°, 720°)². Overlaying the
   workspace map (fig. 4.5, 6.1–6.2) at object angle θ: a contact at ``phi`` lies at
   workspace angle ``phi + θ``, so, seen from the object frame, every finger pair box
   ``ws(fx) × ws(fy)`` is shifted by ``-θ`` along the diagonal; the workspace map repeats
-  every 360° in each axis.
+  every 360° in each axis. A box labelled ``"fx-fy"`` holds the contact pairs that
+  finger ``fx`` (horizontal axis) and finger ``fy`` (vertical axis) can both reach at θ.
+- Gait figures (:func:`gait_figure`) colour the moves by :data:`GAIT_COLORS`.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Rectangle
+from matplotlib.patches import Patch, Rectangle
 from matplotlib.ticker import MaxNLocator
 
 from graspgait_env.atomic import atomic_write
@@ -50,11 +56,21 @@ __all__ = [
     "gait_figure",
     "SWEEP_MUS",
     "BOX_COLORS",
+    "GAIT_COLORS",
+    "STABLE_LABEL",
+    "PHI_I_LABEL",
+    "PHI_J_LABEL",
 ]
 
 SWEEP_MUS: tuple[float, ...] = (0.9, 0.7, 0.5, 0.3, 0.1)  # thesis figs. 3.9, 3.11
 BOX_COLORS = {"inner": "tab:blue", "outer": "tab:red"}  # finger pair box outlines
+# gait figures: rotation and regrasp segments, the grasps, the first and the last state
+GAIT_COLORS = {"rotate": "tab:orange", "regrasp": "magenta", "grasp": "white",
+               "start": "tab:green", "end": "gold"}
 _STABLE_CMAP = "Greys"  # stable cells dark, as the thesis shades them
+STABLE_LABEL = "dark: the two contacts make a force-closure grasp at mu={mu:g}"
+PHI_I_LABEL = "contact of finger i: object angle phi_i (deg)"
+PHI_J_LABEL = "contact of finger j: object angle phi_j (deg)"
 _SWEEP_SIZE = 0.08  # (m) larger semi-axis / circumradius of the sweep objects
 
 
@@ -75,6 +91,7 @@ def plot_object(
     grasp: tuple[float, float] | None = None,
     mu: float | None = None,
     title: str | None = None,
+    legend: bool = False,
 ) -> Figure:
     """Draw an object's contour in its frame ``f`` (thesis figs. 2.11, 3.1, 3.5).
 
@@ -96,6 +113,9 @@ def plot_object(
         With ``grasp``, also draw each contact's friction cone (half-angle ``atan mu``).
     title
         Axes title; default the object's name.
+    legend
+        Add a legend below the axes naming the origin of ``f``, the normals and the
+        contact angles.
 
     Returns
     -------
@@ -141,9 +161,23 @@ def plot_object(
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-lim, lim)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
+    ax.set_xlabel("x in the object frame f (m)")
+    ax.set_ylabel("y in the object frame f (m)")
     ax.set_title(shape.name if title is None else title)
+    if legend:
+        handles = [Line2D([], [], ls="none", marker="+", color="k", ms=8,
+                          label="origin of f: the centre of rotation")]
+        if normals_every_deg and normals_every_deg > 0:
+            handles.append(Line2D([], [], color="tab:green",
+                                  label=f"inward normal, every {normals_every_deg:g} deg"))
+        if len(labels_deg):
+            handles.append(Line2D([], [], ls=":", color="0.5",
+                                  label="contact named by its polar angle phi (deg)"))
+        if grasp is not None:
+            handles.append(Line2D([], [], ls="none", marker="x", color="tab:orange",
+                                  label="grasp: contacts of fingers i and j"))
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12),
+                  ncol=1, fontsize=7, frameon=False)
     return ax.figure
 
 
@@ -160,8 +194,19 @@ def _degree_axes(ax: Axes, span: float, step: float) -> None:
     ax.set_xlim(0.0, span)
     ax.set_ylim(0.0, span)
     ax.set_aspect("equal")
-    ax.set_xlabel("phi_i (deg)")
-    ax.set_ylabel("phi_j (deg)")
+    ax.set_xlabel(PHI_I_LABEL)
+    ax.set_ylabel(PHI_J_LABEL)
+
+
+def _stable_handles(mu: float, short: bool = False) -> list[Patch]:
+    """Legend entries for the shading of a grasp map at friction ``mu``."""
+    if short:
+        return [Patch(facecolor="black", edgecolor="0.5",
+                      label=f"dark: force-closure grasp at mu={mu:g}"),
+                Patch(facecolor="white", edgecolor="0.5", label="white: not force-closure")]
+    return [Patch(facecolor="black", edgecolor="0.5", label=STABLE_LABEL.format(mu=mu)),
+            Patch(facecolor="white", edgecolor="0.5",
+                  label="white: not force-closure (or a contact on a vertex / out of reach)")]
 
 
 def plot_grasp_map(
@@ -174,9 +219,9 @@ def plot_grasp_map(
 ) -> Figure:
     """Shade the stable cells of a grasp map (thesis figs. 2.11, 3.1–3.13).
 
-    The horizontal axis is ``phi_i`` (finger i), the vertical ``phi_j`` (finger j), in
-    degrees of the object frame, origin at the bottom left; cell ``(i, j)`` is centred
-    on ``(phi_i, phi_j)``.
+    The horizontal axis is ``phi_i`` (the contact of finger i), the vertical ``phi_j``
+    (finger j), in degrees of the object frame, origin at the bottom left; cell
+    ``(i, j)`` is centred on ``(phi_i, phi_j)`` and dark when the pair is force-closure.
 
     Parameters
     ----------
@@ -189,7 +234,8 @@ def plot_grasp_map(
     title
         Axes title; default ``"grasp map, mu=..."``.
     labels
-        Axis labels and ticks every 90°; ``False`` for small multiples (ticks only).
+        Axis labels, ticks every 90° and a legend below the axes saying what a dark
+        cell means; ``False`` for small multiples (ticks only).
 
     Returns
     -------
@@ -203,8 +249,14 @@ def plot_grasp_map(
     if not labels:
         ax.set_xlabel("")
         ax.set_ylabel("")
+    handles: list = _stable_handles(gm.mu)
     if grasp is not None:
         ax.plot([grasp[0] % 360.0], [grasp[1] % 360.0], "x", color="tab:orange", ms=9, mew=2)
+        handles.append(Line2D([], [], ls="none", marker="x", color="tab:orange", mew=2,
+                              label="the grasp (phi_i, phi_j)"))
+    if labels:
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=1,
+                  fontsize=7, frameon=False)
     ax.set_title(f"grasp map, mu={gm.mu:g}" if title is None else title)
     return ax.figure
 
@@ -256,7 +308,9 @@ def plot_extended_map(
     seen from the object frame at object angle ``theta_deg``: shifted by ``-theta_deg``
     along the diagonal and repeated every 360° (see :func:`extended_box_rects`). Boxes
     are labelled ``"fx-fy"`` (finger on the horizontal axis first, e.g. ``"1-3"``).
-    Each rectangle's ``gid`` is ``"box fx-fy kind"``.
+    Each rectangle's ``gid`` is ``"box fx-fy kind"``. A legend below the axes says what
+    a dark cell and a box mean: box ``fx-fy`` holds the contact pairs that finger
+    ``fx`` and finger ``fy`` can both reach at θ.
 
     Parameters
     ----------
@@ -297,11 +351,18 @@ def plot_extended_map(
                           "alpha": 0.7})
     _degree_axes(ax, span, 180.0)
     ax.plot([0.0, span], [0.0, span], ls=":", lw=0.6, color="0.5")  # the +1 diagonal
-    ax.legend(handles=[Line2D([], [], color=BOX_COLORS["inner"], label="inner box"),
-                       Line2D([], [], color=BOX_COLORS["outer"], label="outer box")],
-              loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=2, fontsize=7,
-              frameon=False)
-    ax.set_title(f"extended map, theta={theta_deg:g} deg" if title is None else title)
+    # compact (two columns): the GraspGait environments draw this panel in a small frame
+    dark, white = _stable_handles(gm.mu, short=True)
+    ax.legend(handles=[dark, Line2D([], [], color=BOX_COLORS["inner"],
+                                    label="inner finger pair box"),
+                       white, Line2D([], [], color=BOX_COLORS["outer"],
+                                     label="outer finger pair box")],
+              title=(f"box a-b: pairs fingers a (x) and b (y) both reach at "
+                     f"theta={theta_deg:g} deg"),
+              title_fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
+              fontsize=7, frameon=False)
+    ax.set_title(f"extended map and finger pair boxes, theta={theta_deg:g} deg"
+                 if title is None else title)
     return ax.figure
 
 
@@ -346,15 +407,16 @@ def map_figure(
     if gm is None:
         gm = grasp_map(shape, mu, n, max_radius=max_radius)
     hand = Hand.default() if hand is None else hand
-    fig = Figure(figsize=(15.0, 5.4), layout="constrained")
+    fig = Figure(figsize=(15.0, 6.0), layout="constrained")
     ax_o, ax_g, ax_e = fig.subplots(1, 3, width_ratios=[1.0, 1.0, 1.0])
-    plot_object(ax_o, shape, title="object, inward normals")
+    plot_object(ax_o, shape, title="object in its frame f", legend=True)
     plot_grasp_map(ax_g, gm)
     plot_extended_map(ax_e, gm, hand, theta_deg)
     fig.suptitle(
-        f"{shape.name}: mu={gm.mu:g}, E={shape.eccentricity:.3g}, S={_smooth_label(shape)}"
-        f" (n={gm.n}, {100 * gm.fraction_stable():.1f}% stable; hand {hand.name},"
-        f" w={hand.w_deg:g} deg)"
+        f"{shape.name}: mu={gm.mu:g}, E={shape.eccentricity:.3g} (r_max / r_min), "
+        f"S={_smooth_label(shape)} (sides; inf: smooth)"
+        f" (n={gm.n}, {100 * gm.fraction_stable():.1f}% of pairs stable; hand {hand.name},"
+        f" gap w={hand.w_deg:g} deg)"
     )
     return fig
 
@@ -437,12 +499,22 @@ def sweep_figure(kind: str, mus: Sequence[float] = SWEEP_MUS, n: int = 180) -> F
             if r == 0:
                 ax.set_title(f"mu={mu:g}", fontsize=10)
             if r == len(rows) - 1:
-                ax.set_xlabel("phi_i (deg)", fontsize=7)
+                ax.set_xlabel("finger i contact phi_i (deg)", fontsize=7)
             if c == 1:
-                ax.set_ylabel("phi_j (deg)", fontsize=7)
+                ax.set_ylabel("finger j contact phi_j (deg)", fontsize=7)
     what = "eccentricity" if kind == "eccentricity" else "smoothness"
     fig.suptitle(f"Grasp maps: {what} decreasing down the rows, friction decreasing to the "
                  f"right (n={n}; % = stable fraction)")
+    fig.legend(handles=[Patch(facecolor="black", edgecolor="0.5",
+                              label="dark: the two contacts (phi_i, phi_j), object frame, "
+                              "make a force-closure grasp at the column's mu"),
+                        Patch(facecolor="white", edgecolor="0.5", label="white: not "
+                              "force-closure"),
+                        Line2D([], [], ls="none",
+                               label="rows: E = r_max / r_min (1: circle)"
+                               if kind == "eccentricity"
+                               else "rows: S = number of sides (inf: smooth)")],
+               loc="outside lower center", ncol=3, fontsize=8, frameon=False)
     return fig
 
 
@@ -499,59 +571,122 @@ def gait_path(plan_steps: Sequence[dict]) -> list[dict]:
     return pts
 
 
+def _box_label(ax: Axes, text: str, x: float, y: float, color: str, fontsize: float) -> None:
+    ax.text(x, y, text, color=color, fontsize=fontsize, ha="center", va="center",
+            clip_on=True, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                                "alpha": 0.7})
+
+
+def _segments(xy: np.ndarray, pts: Sequence[dict], op: str) -> np.ndarray:
+    """The path segments that end in an ``op`` step, NaN-separated for one ``plot``."""
+    out = []
+    for i in range(1, len(pts)):
+        if pts[i]["op"] == op:
+            out += [xy[i - 1], xy[i], (np.nan, np.nan)]
+    return np.array(out, dtype=float).reshape(-1, 2)
+
+
 def gait_figure(gm: GraspMap, hand: Hand, plan_steps: Sequence[dict],
                 title: str = "") -> Figure:
     """A gait drawn two ways (thesis figs. 4.6–4.8, 6.10).
 
     Left, the **workspace frame**: the finger pair boxes of the extended workspace map
-    stand still; rotations are diagonal segments (both workspace angles grow by the
-    same amount), regrasps horizontal or vertical moves into another box. Right, the
+    stand still (each labelled ``a-b``: finger a on the horizontal axis, finger b on the
+    vertical); rotations are diagonal segments (both workspace angles grow by the same
+    amount), regrasps horizontal or vertical moves into another box. Right, the
     **object frame**: the extended grasp map with the sequence of grasps; rotations
     leave the grasp point in place (the boxes slide instead, fig. 4.5) and regrasps are
     horizontal or vertical moves, giving the staircase or plus patterns of fig. 6.10.
-    Grasp points are numbered in order.
+
+    Colours (:data:`GAIT_COLORS`, named in the figure's legend below the panels):
+    rotations orange, regrasps magenta, grasps white dots numbered in order with their
+    fingers (``k: a-b``), the start a green square, the end a gold star; boxes inner
+    blue, outer red; dark cells force-closure at the map's ``mu``.
     """
     pts = gait_path(plan_steps)
-    fig = Figure(figsize=(13, 6.4), layout="constrained")
+    fig = Figure(figsize=(13, 7.6), layout="constrained")
     axes = fig.subplots(1, 2)
+    col = GAIT_COLORS
     for ax, key in zip(axes, ("ws", "obj"), strict=True):
         xy = np.array([p[key] for p in pts])
-        lo = np.floor((xy.min() - 100.0) / 90.0) * 90.0
-        hi = np.ceil((xy.max() + 100.0) / 90.0) * 90.0
+        # a square window round the path, 60 degrees of margin on its longer side
+        mid = (xy.min(axis=0) + xy.max(axis=0)) / 2.0
+        half = float(np.ptp(xy, axis=0).max()) / 2.0 + 60.0
+        (xlo, ylo), (xhi, yhi) = mid - half, mid + half
+        lo, hi = min(xlo, ylo), max(xhi, yhi)
         if key == "obj":
-            # tile the grasp map over [lo, hi]^2 (cell k centred on k * step)
+            # tile the grasp map over the window (cell k centred on k * step)
             n, step = gm.n, gm.step_deg
-            idx = np.arange(int(np.floor(lo / step)), int(np.ceil(hi / step)) + 1)
-            tile = gm.stable[np.ix_(idx % n, idx % n)]
+            ix = np.arange(int(np.floor(xlo / step)), int(np.ceil(xhi / step)) + 1)
+            iy = np.arange(int(np.floor(ylo / step)), int(np.ceil(yhi / step)) + 1)
+            tile = gm.stable[np.ix_(ix % n, iy % n)]
             ax.imshow(tile.T, origin="lower", cmap=_STABLE_CMAP, vmin=0, vmax=1,
                       interpolation="nearest",
-                      extent=[idx[0] * step - step / 2, idx[-1] * step + step / 2,
-                              idx[0] * step - step / 2, idx[-1] * step + step / 2])
-            ax.set_title("object frame: extended grasp map and grasps")
+                      extent=[ix[0] * step - step / 2, ix[-1] * step + step / 2,
+                              iy[0] * step - step / 2, iy[-1] * step + step / 2])
+            ax.set_title("object frame f: extended grasp map and the grasps\n"
+                         "(a rotation leaves the grasp in place; the boxes slide instead)")
         else:
             reps = range(int(np.floor(lo / 360.0)) - 1, int(np.ceil(hi / 360.0)) + 1)
             for box in hand.finger_pair_boxes:
                 (xl, xh), (yl, yh) = box.x_deg, box.y_deg
+                color = BOX_COLORS.get(box.kind, "k")
                 for a in reps:
                     for b in reps:
-                        ax.add_patch(Rectangle((xl + 360.0 * a, yl + 360.0 * b), xh - xl,
-                                               yh - yl, fill=False,
-                                               edgecolor=BOX_COLORS.get(box.kind, "k"),
-                                               lw=1.0))
-            ax.set_title("workspace frame: finger pair boxes, rotations diagonal")
-        ax.plot(xy[:, 0], xy[:, 1], "-", color="tab:orange", lw=1.6, zorder=3)
+                        x0, y0 = xl + 360.0 * a, yl + 360.0 * b
+                        ax.add_patch(Rectangle((x0, y0), xh - xl, yh - yl, fill=False,
+                                               edgecolor=color, lw=1.0,
+                                               gid=f"box {box.finger_x}-{box.finger_y} "
+                                               f"{box.kind}"))
+                        cx, cy = x0 + (xh - xl) / 2, y0 + (yh - yl) / 2
+                        if xlo < cx < xhi and ylo < cy < yhi:
+                            _box_label(ax, f"{box.finger_x}-{box.finger_y}", cx, cy, color, 6)
+            ax.set_title("workspace frame F: finger pair boxes stand still,\n"
+                         "rotations are diagonal moves")
+        rot = _segments(xy, pts, "rotate")
+        reg = _segments(xy, pts, "regrasp")
+        ax.plot(rot[:, 0], rot[:, 1], "-", color=col["rotate"], lw=1.8, zorder=3)
+        ax.plot(reg[:, 0], reg[:, 1], "-", color=col["regrasp"], lw=1.8, zorder=3)
         grasps = [i for i, p in enumerate(pts) if p["op"] != "rotate"]
-        ax.plot(xy[grasps, 0], xy[grasps, 1], "o", color="tab:orange", ms=4, zorder=4)
-        ax.plot(*xy[0], "s", color="tab:green", ms=8, zorder=5, label="start")
-        ax.plot(*xy[-1], "*", color="tab:red", ms=12, zorder=5, label="end")
+        ax.plot(xy[grasps, 0], xy[grasps, 1], "o", mfc=col["grasp"], mec="k", ms=5,
+                zorder=4)
+        ax.plot(*xy[0], "s", color=col["start"], mec="k", ms=9, zorder=5)
+        ax.plot(*xy[-1], "*", color=col["end"], mec="k", ms=14, zorder=5)
         for num, i in enumerate(grasps):
-            ax.annotate(str(num), xy[i], textcoords="offset points", xytext=(4, 4), fontsize=7)
-        ax.set_xlim(lo, hi)
-        ax.set_ylim(lo, hi)
+            fx, fy = pts[i]["fingers"]
+            ax.annotate(f"{num}: {fx}-{fy}", xy[i], textcoords="offset points", xytext=(5, -9),
+                        fontsize=7, color="k",
+                        bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
+                              "alpha": 0.75})
+        ax.set_xlim(xlo, xhi)
+        ax.set_ylim(ylo, yhi)
         ax.set_aspect("equal")
-        what = "object-frame contact" if key == "obj" else "workspace-frame angle"
-        ax.set_xlabel(f"x finger: {what} (deg)")
-        ax.set_ylabel(f"y finger: {what} (deg)")
-        ax.legend(loc="upper left", fontsize=7)
+        if key == "obj":
+            ax.set_xlabel("finger on x: contact phi, object frame (deg, unwrapped)")
+            ax.set_ylabel("finger on y: contact phi, object frame (deg, unwrapped)")
+        else:
+            ax.set_xlabel("finger on x: workspace angle phi + theta, frame F (deg, unwrapped)")
+            ax.set_ylabel("finger on y: workspace angle phi + theta, frame F (deg, unwrapped)")
+    dark, white = _stable_handles(gm.mu)
+    dark.set_label("right, " + dark.get_label())
+    white.set_label("right, " + white.get_label())
+    handles = [  # filled column by column, three rows
+        Line2D([], [], color=col["rotate"], lw=1.8,
+               label="rotation: the object turns, both contacts held"),
+        Line2D([], [], color=col["regrasp"], lw=1.8,
+               label="regrasp: the free finger placed, then one old finger lifted"),
+        Line2D([], [], ls="none", marker="o", mfc=col["grasp"], mec="k", ms=5,
+               label="grasp k: a-b = finger a on x, finger b on y"),
+        Line2D([], [], ls="none", marker="s", color=col["start"], mec="k", ms=8,
+               label="start (theta = 0)"),
+        Line2D([], [], ls="none", marker="*", color=col["end"], mec="k", ms=12,
+               label="end (the turn achieved)"),
+        Line2D([], [], color=BOX_COLORS["inner"],
+               label="left, inner finger pair box a-b: fingers a (x) and b (y) reach"),
+        Line2D([], [], color=BOX_COLORS["outer"],
+               label="left, outer finger pair box a-b: fingers a (x) and b (y) reach"),
+        dark, white,
+    ]
+    fig.legend(handles=handles, loc="outside lower center", ncol=3, fontsize=8, frameon=False)
     fig.suptitle(title)
     return fig

@@ -151,3 +151,18 @@ def test_console_script(tmp_path):
                         "--npy", str(npy)], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     np.testing.assert_array_equal(np.load(npy), grasp_map(load_object("circle"), 0.3, 36).stable)
+
+
+def test_plan_of_an_object_file_names_the_file(tmp_path):
+    """A plan made from an object YAML names that file, so it can be replayed anywhere."""
+    from graspgait_env.objects import OBJECT_DIR
+    from graspgait_env.plan import Plan, validate_plan
+
+    obj = tmp_path / "my_ellipse.yaml"
+    obj.write_text((OBJECT_DIR / "ellipse.yaml").read_text().replace("name: ellipse",
+                                                                      "name: my_ellipse"))
+    out = tmp_path / "plan.json"
+    assert main(["plan", str(obj), "--mu", "0.7", "--planner", "rule", "--json", str(out)]) == 0
+    plan = Plan.load(out)
+    assert plan.object == str(obj)
+    assert validate_plan(plan) is None

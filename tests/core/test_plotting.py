@@ -1,4 +1,5 @@
-"""Figures: every bundled object draws; the workspace boxes sit where thesis 4.4–4.5 puts them."""
+"""Figures: every bundled object draws; the workspace boxes sit where thesis 4.4–4.5 puts them;
+every figure reads without the thesis (axes in words, legends for cells, boxes and colours)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ from matplotlib.patches import Rectangle  # noqa: E402
 
 from graspgait_env import bundled_objects, grasp_map, load_object  # noqa: E402
 from graspgait_env.plotting import (  # noqa: E402
+    GAIT_COLORS,
     extended_box_rects,
+    gait_figure,
     map_figure,
     plot_extended_map,
     plot_grasp_map,
@@ -80,7 +83,7 @@ def test_grasp_map_image_axes():
     assert im.origin == "lower"
     h = 360.0 / N / 2
     np.testing.assert_allclose(im.get_extent(), [-h, 360 - h, -h, 360 - h])
-    assert ax.get_xlabel() == "phi_i (deg)" and ax.get_ylabel() == "phi_j (deg)"
+    assert "phi_i (deg)" in ax.get_xlabel() and "phi_j (deg)" in ax.get_ylabel()
     assert ax.get_xlim() == (0.0, 360.0)
 
 
@@ -179,3 +182,111 @@ def test_save_figure_is_atomic(tmp_path):
     save_figure(fig, target)
     assert target.read_bytes()[:8] == PNG_MAGIC
     assert [p.name for p in target.parent.iterdir()] == ["fig.png"]  # no temp file left
+
+
+# ------------------------------------------------------------- figures read without the thesis
+# The first gait steps of `graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270`
+# (thesis fig. 4.6): rotate 40, finger 2 replaces finger 1, rotate 20, finger 1 replaces 3.
+GAIT_STEPS = [
+    {"op": "grasp", "contacts": {"1": 50.0, "3": 270.0}},
+    {"op": "rotate", "delta": 40.0},
+    {"op": "regrasp", "contacts": {"2": 92.0, "3": 270.0}},
+    {"op": "rotate", "delta": 20.0},
+    {"op": "regrasp", "contacts": {"1": 300.0, "2": 92.0}},
+    {"op": "rotate", "delta": 58.0},
+]
+
+
+def _legend_texts(legend) -> list[str]:
+    assert legend is not None, "the axes have no legend"
+    return [t.get_text() for t in legend.get_texts()]
+
+
+def _has(texts: list[str], *words: str) -> bool:
+    """Some legend entry contains every one of ``words``."""
+    return any(all(w in t for w in words) for t in texts)
+
+
+def test_grasp_map_axes_in_words_and_dark_cells_explained():
+    gm = grasp_map(load_object("ellipse"), 0.5, N)
+    fig = Figure()
+    ax = fig.add_subplot()
+    plot_grasp_map(ax, gm)
+    assert "contact of finger i" in ax.get_xlabel() and "object angle" in ax.get_xlabel()
+    assert "contact of finger j" in ax.get_ylabel() and "object angle" in ax.get_ylabel()
+    texts = _legend_texts(ax.get_legend())
+    assert _has(texts, "dark", "force-closure", "mu=0.5")
+    assert _has(texts, "white", "not force-closure")
+
+
+def test_small_multiples_have_no_legend():
+    fig = Figure()
+    ax = fig.add_subplot()
+    plot_grasp_map(ax, grasp_map(load_object("circle"), 0.5, N), labels=False)
+    assert ax.get_legend() is None and ax.get_xlabel() == ""
+
+
+def test_extended_map_names_and_explains_the_boxes():
+    gm = grasp_map(load_object("circle"), 0.3, N)
+    fig = Figure()
+    ax = fig.add_subplot()
+    plot_extended_map(ax, gm, Hand.default(), 30.0)
+    legend = ax.get_legend()
+    texts = _legend_texts(legend)
+    assert _has(texts, "dark", "force-closure", "mu=0.3")
+    assert _has(texts, "inner", "finger pair box") and _has(texts, "outer", "finger pair box")
+    title = legend.get_title().get_text()
+    assert "box a-b" in title and "fingers a (x) and b (y)" in title and "theta=30" in title
+    # every finger pair is named on its boxes
+    names = {t.get_text() for t in ax.texts}
+    assert {"1-2", "1-3", "2-1", "2-3", "3-1", "3-2"} <= names
+    assert "contact of finger i" in ax.get_xlabel() and "contact of finger j" in ax.get_ylabel()
+
+
+def test_map_figure_every_panel_has_a_legend():
+    fig = map_figure(load_object("pentagon"), 0.7, N, theta_deg=30.0)
+    ax_o, ax_g, ax_e = fig.axes
+    assert _has(_legend_texts(ax_o.get_legend()), "origin of f", "centre of rotation")
+    assert _has(_legend_texts(ax_o.get_legend()), "inward normal")
+    assert "object frame" in ax_o.get_xlabel()
+    assert _has(_legend_texts(ax_g.get_legend()), "force-closure", "mu=0.7")
+    assert "theta=30" in ax_e.get_legend().get_title().get_text()
+
+
+def test_gait_figure_colours_explained():
+    gm = grasp_map(load_object("pentagon"), 0.7, N)
+    fig = gait_figure(gm, Hand.default(), GAIT_STEPS, title="t")
+    ax_ws, ax_obj = fig.axes
+    (legend,) = fig.legends
+    texts = _legend_texts(legend)
+    for words in (("rotation",), ("regrasp",), ("start",), ("end",),
+                  ("grasp k", "finger a on x"), ("inner finger pair box", "fingers a (x)"),
+                  ("outer finger pair box",), ("dark", "force-closure", "mu=0.7")):
+        assert _has(texts, *words), (words, texts)
+    # the legend's colours are the colours drawn, and rotations and regrasps differ
+    by_label = dict(zip(texts, legend.legend_handles, strict=True))
+    rot = next(h for t, h in by_label.items() if t.startswith("rotation"))
+    reg = next(h for t, h in by_label.items() if t.startswith("regrasp"))
+    assert rot.get_color() == GAIT_COLORS["rotate"] != GAIT_COLORS["regrasp"]
+    assert reg.get_color() == GAIT_COLORS["regrasp"]
+    for ax in (ax_ws, ax_obj):
+        colors = {ln.get_color() for ln in ax.lines}
+        assert {GAIT_COLORS["rotate"], GAIT_COLORS["regrasp"]} <= colors
+        # grasps numbered in order with their fingers (x first): 0: 1-3, 1: 2-3, 2: 2-1
+        notes = [t.get_text() for t in ax.texts if ":" in t.get_text()]
+        assert notes == ["0: 1-3", "1: 2-3", "2: 2-1"]
+    assert "workspace angle" in ax_ws.get_xlabel() and "finger on x" in ax_ws.get_xlabel()
+    assert "object frame" in ax_obj.get_xlabel() and "finger on y" in ax_obj.get_ylabel()
+    # in the workspace frame the first rotation is the diagonal (50, 270) -> (90, 310)
+    rot_line = next(ln for ln in ax_ws.lines if ln.get_color() == GAIT_COLORS["rotate"])
+    np.testing.assert_allclose(np.c_[rot_line.get_data()][:2], [[50, 270], [90, 310]])
+    # and the finger pair boxes are named where they stand
+    assert {"1-3", "2-3", "2-1"} <= {t.get_text() for t in ax_ws.texts}
+
+
+def test_sweep_figure_explains_dark_cells():
+    fig = sweep_figure("smoothness", (0.5,), N)
+    (legend,) = fig.legends
+    texts = _legend_texts(legend)
+    assert _has(texts, "dark", "force-closure") and _has(texts, "S = number of sides")
+    assert "phi_i" in fig.axes[-1].get_xlabel() and "finger i" in fig.axes[-1].get_xlabel()
