@@ -100,7 +100,9 @@ def test_usage_errors_exit_2(capsys):
     assert main(["map", "ellipse"]) == 2  # --mu is required
     assert main(["sweep", "roundness"]) == 2
     assert main([]) == 2
-    assert "usage" in capsys.readouterr().err
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 3  # one line per usage error, each pointing at --help
+    assert all("error:" in ln and "--help" in ln for ln in lines)
 
 
 def test_no_gait_exits_1(monkeypatch, capsys):
