@@ -432,7 +432,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     # imported here so that MUJOCO_GL=egl is set (graspgait_env.sim) before MuJoCo loads
     from graspgait_env.sim.simulate import simulate_command
 
-    _check_outputs(args, {"json": (".json",), "video": (".mp4",)})
+    _check_outputs(args, {"json": (".json",)})  # --video: simulate_command checks it
     return simulate_command(args.plan, video=args.video, seed=args.seed, perturb=args.perturb,
                             config=args.config, json_out=args.json, progress=not args.quiet)
 

@@ -8,6 +8,7 @@ atomic (:mod:`graspgait_env.atomic`).
 from __future__ import annotations
 
 import os
+import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -73,7 +74,11 @@ def check_output_path(flag: str, path: str | os.PathLike[str],
                 "give a path in a writable folder") from None
     if not parent.is_dir():
         raise GraspGaitInputError(f"{flag} {text}: {parent} is not a folder; give a path in one")
-    if not os.access(parent, os.W_OK | os.X_OK):
+    try:  # a real write, not os.access: right for root and for read-only file systems
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as exc:
         raise GraspGaitInputError(
-            f"{flag} {text}: the folder {parent} is not writable; give a writable path")
+            f"{flag} {text}: cannot write in the folder {parent} ({exc.strerror or exc}); "
+            "give a path in a writable folder") from None
     return p

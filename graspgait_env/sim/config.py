@@ -26,12 +26,10 @@ from typing import Any
 from graspgait_env.errors import ConfigError
 from graspgait_env.objects import read_yaml_mapping
 from graspgait_env.resources import config_dir
+from graspgait_env.sim.frames import INCH, LB_TO_N, OZ_TO_N
 
 __all__ = ["SimConfig", "load_sim_config", "DEFAULT_SIM_CONFIG", "LB_TO_N", "OZ_TO_N", "INCH"]
 
-INCH = 0.0254  # (m)
-LB_TO_N = 4.448222  # (N per pound-force)
-OZ_TO_N = LB_TO_N / 16.0  # (N per ounce-force)
 DEFAULT_SIM_CONFIG = config_dir("sim") / "default.yaml"  # bundled (graspgait_env.resources)
 
 
@@ -72,6 +70,8 @@ class SimConfig:
     """Object mass (kg); None: the object file's."""
     mesh_segments: int = 128
     """Facets of the prism that stands in for a smooth contour."""
+    object_settle_time: float = 0.05
+    """Physics alone (no controller) at a reset, for the object to settle on the table (s)."""
 
     # hand
     tip_radius: float = 0.307 * INCH
@@ -118,6 +118,8 @@ class SimConfig:
     """Tip acceleration limit of object rotations and recentering moves (m/s^2)."""
     approach_accel: float = 2.0
     """Acceleration limit on approach lines, where contact detection is armed (m/s^2)."""
+    recenter_speed: float = 0.12
+    """Speed of the recentering move that drags the held object back (m/s, thesis 7.5)."""
 
     # grip (thesis 7.3, 7.4.3-7.4.4)
     grip_force: float = 2.0
@@ -148,6 +150,12 @@ class SimConfig:
     """Touch the object with all three fingers and localize it before the first grasp."""
     probe_grip: float = 0.5
     """Internal force between each pair of fingers while the probe localizes (N)."""
+    probe_margin_deg: float = 10.0
+    """Probe contacts stay this far in from each end of a finger's workspace (deg)."""
+    probe_step_deg: float = 4.0
+    """Spacing of the probe's candidate contact angles (deg)."""
+    probe_vertex_clearance_deg: float = 8.0
+    """Probe contacts stay this far from a vertex of the expected polygon (deg)."""
     localizer_prior_weight: float = 0.01
     """Weight of the expected pose in the localizer's search (LocalizerConfig.prior_weight)."""
     recenter_distance: float = 0.25 * INCH
@@ -160,8 +168,12 @@ class SimConfig:
     """A gait succeeds when it ends within this of the planned orientation (deg)."""
 
     # monitoring (ground truth, not seen by the controller)
+    monitor_every: int = 5
+    """Servo cycles between the monitor's ground-truth checks (drops)."""
     drop_distance: float = 0.03
     """Object farther than this (m) from where the plan wants it counts as dropped."""
+    drop_tilt_deg: float = 20.0
+    """Object tilted more than this (deg) from upright counts as dropped (tipped over)."""
     lost_contact_time: float = 0.1
     """Fewer than two fingers touching for this long (s) counts as dropped."""
     slip_threshold: float = 0.002
@@ -176,6 +188,8 @@ class SimConfig:
     """Video height (pixels)."""
     video_camera: str = "overview"
     """Camera name in the model: ``overview`` or ``top``."""
+    video_tail_s: float = 0.5
+    """The video holds the final state this long after the last move (s)."""
 
     # --------------------------------------------------------------- derived
     @property
@@ -205,8 +219,12 @@ _CHOICES = {
     "video_camera": ("overview", "top"),
 }
 _NONNEG = {"localizer_prior_weight", "noslip_iterations", "finger_damping", "overshoot",
-           "settle_time", "kv", "kv_z"}
+           "settle_time", "kv", "kv_z", "probe_margin_deg", "probe_vertex_clearance_deg",
+           "object_settle_time", "video_tail_s"}
 _OPTIONAL = {"finger_mu", "object_mass", "cone_mu", "home_angles_deg"}
+_MAXIMUM = {  # upper bounds, with why
+    "drop_tilt_deg": (90.0, "an object tilted 90 deg lies on its side"),
+}
 
 
 def _validated(cfg: SimConfig, src: str) -> SimConfig:
@@ -249,6 +267,10 @@ def _validated(cfg: SimConfig, src: str) -> SimConfig:
             raise ConfigError(src, f.name, f"{v!r} is out of range",
                               f"set {f.name} to a value > 0" if f.name not in _NONNEG
                               else f"set {f.name} to a value >= 0")
+        if f.name in _MAXIMUM and v > _MAXIMUM[f.name][0]:
+            hi, why = _MAXIMUM[f.name]
+            raise ConfigError(src, f.name, f"{v!r} is out of range ({why})",
+                              f"set {f.name} to a value <= {hi:g}")
     return cfg
 
 

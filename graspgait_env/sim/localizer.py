@@ -123,6 +123,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from graspgait_env.shapes import Polygon, Shape
+from graspgait_env.sim.frames import INCH, wrap_deg
 
 __all__ = [
     "LocalizerConfig",
@@ -136,14 +137,6 @@ __all__ = [
     "curvature_weights",
     "wrap_deg",
 ]
-
-INCH = 0.0254  # (m)
-
-
-def wrap_deg(angle_deg: ArrayLike) -> NDArray[np.float64]:
-    """Angle (degrees) wrapped to [-180, 180)."""
-    return np.mod(np.asarray(angle_deg, dtype=np.float64) + 180.0, 360.0) - 180.0
-
 
 # --------------------------------------------------------------------------- config
 

@@ -24,7 +24,6 @@ dm_control's ``Physics``: addresses are looked up by element name once, at const
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +35,8 @@ from numpy.typing import NDArray
 
 from graspgait_env.shapes import Circle, Ellipse, Polygon, Shape
 from graspgait_env.sim.config import SimConfig
+from graspgait_env.sim.frames import quat_from_yaw_deg, tilt_deg_from_quat, yaw_deg_from_quat
+from graspgait_env.workspace import DEFAULT_WORKSPACES_DEG
 
 __all__ = ["SimModel", "HandPhysics", "build_mjcf", "build_model", "contour_polygon",
            "prism_inertia", "ASSET_XML", "FINGERS"]
@@ -130,7 +131,7 @@ class SimModel:
 
 def build_mjcf(shape: Shape, *, mu: float, thickness: float, mass: float,
                config: SimConfig,
-               workspaces_deg=((0.0, 90.0), (120.0, 210.0), (240.0, 330.0)),
+               workspaces_deg=DEFAULT_WORKSPACES_DEG,
                ) -> tuple[str, dict]:
     """MJCF text of the hand with ``shape`` inserted, and facts about it.
 
@@ -250,7 +251,7 @@ def build_mjcf(shape: Shape, *, mu: float, thickness: float, mass: float,
 
 def build_model(shape: Shape, *, mu: float, thickness: float, mass: float,
                 config: SimConfig,
-                workspaces_deg=((0.0, 90.0), (120.0, 210.0), (240.0, 330.0))) -> SimModel:
+                workspaces_deg=DEFAULT_WORKSPACES_DEG) -> SimModel:
     """Compile :func:`build_mjcf`'s MJCF into a :class:`SimModel`."""
     xml, info = build_mjcf(shape, mu=mu, thickness=thickness, mass=mass, config=config,
                            workspaces_deg=workspaces_deg)
@@ -343,10 +344,8 @@ class HandPhysics:
         """True object pose ``(x, y, theta_deg)`` in frame F (theta in (-180, 180])."""
         q = self.data.qpos
         a = self._obj_qpos
-        w, z = q[a + 3], q[a + 6]
-        x_, y_ = q[a + 4], q[a + 5]
-        theta = math.atan2(2 * (w * z + x_ * y_), 1 - 2 * (y_ * y_ + z * z))
-        return float(q[a]), float(q[a + 1]), math.degrees(theta)
+        return float(q[a]), float(q[a + 1]), yaw_deg_from_quat(q[a + 3], q[a + 4], q[a + 5],
+                                                               q[a + 6])
 
     def object_height(self) -> float:
         """Height of the object's origin above the table (m)."""
@@ -354,17 +353,13 @@ class HandPhysics:
 
     def object_tilt_deg(self) -> float:
         """Angle between the object's z axis and the vertical (deg)."""
-        q = self.data.qpos[self._obj_qpos + 3:self._obj_qpos + 7]
-        w, x, y, z = q
-        zz = 1 - 2 * (x * x + y * y)
-        return math.degrees(math.acos(max(-1.0, min(1.0, zz))))
+        w, x, y, z = self.data.qpos[self._obj_qpos + 3:self._obj_qpos + 7]
+        return tilt_deg_from_quat(w, x, y, z)
 
     def set_object_pose(self, x: float, y: float, theta_deg: float) -> None:
         """Place the object flat on the table at ``(x, y, theta_deg)``, at rest."""
         a = self._obj_qpos
-        t = math.radians(theta_deg) / 2.0
-        self.data.qpos[a:a + 7] = [x, y, self.sim.thickness / 2.0, math.cos(t), 0, 0,
-                                   math.sin(t)]
+        self.data.qpos[a:a + 7] = [x, y, self.sim.thickness / 2.0, *quat_from_yaw_deg(theta_deg)]
         self.data.qvel[self._obj_dof:self._obj_dof + 6] = 0.0
 
     def apply_object_force(self, force_xy: tuple[float, float] | NDArray[np.float64]) -> None:

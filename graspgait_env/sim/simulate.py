@@ -23,14 +23,24 @@ import numpy as np
 
 from graspgait_env.atomic import atomic_write
 from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.objects import load_object
 from graspgait_env.plan import Plan
-from graspgait_env.shapes import Circle
+from graspgait_env.shapes import Circle, Shape
 from graspgait_env.sim.config import SimConfig, load_sim_config
-from graspgait_env.sim.executor import GaitExecutor, random_pose_perturbation
+from graspgait_env.sim.executor import (
+    PERTURBATION_MAX_ANGLE_DEG,
+    PERTURBATION_MAX_OFFSET_M,
+    THESIS_MU,
+    GaitExecutor,
+    random_pose_perturbation,
+)
 
 __all__ = ["simulate_plan", "simulate_command", "parse_perturbation", "benchmark_step_rate",
-           "format_result", "default_plan", "tug_test",
-           "VideoRecorder"]
+           "format_result", "default_plan", "tug_test", "perturbation_limits",
+           "check_perturbation", "check_video_path", "VideoRecorder", "VIDEO_SUFFIX"]
+
+VIDEO_SUFFIX = ".mp4"  # the container simulate_plan writes (imageio's FFMPEG plugin)
+TUG_REPORT_S = 0.05  # (s) the tug test holds in pieces this long, checking contact after each
 
 
 class VideoRecorder:
@@ -140,7 +150,7 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
                 ex.frame_callback = rec
                 try:
                     result.update(_execute(ex, plan, pert, progress))
-                    for _ in range(cfg.video_fps // 2):  # half a second of the end
+                    for _ in range(int(cfg.video_tail_s * cfg.video_fps)):  # the end, held
                         rec(ex.physics)
                 finally:
                     ex.frame_callback = None
@@ -291,7 +301,7 @@ def benchmark_step_rate(plan: Plan | None = None, *, object: str = "ellipse",
 def tug_test(object: str = "circle", contacts: dict | None = None, *,
              force: float = 4.0, direction_deg: float | None = None, along_grip: bool = False,
              grip_check: bool = True, ramp_s: float = 0.5, hold_s: float = 0.5,
-             config: SimConfig | str | None = None, mu: float = 0.7) -> dict[str, Any]:
+             config: SimConfig | str | None = None, mu: float = THESIS_MU) -> dict[str, Any]:
     """Pull on a grasped object (thesis 7.5's tug) and measure what the grasp does.
 
     The object is grasped at ``contacts`` (default: fingers 1 and 2 on opposite sides,
@@ -327,7 +337,7 @@ def tug_test(object: str = "circle", contacts: dict | None = None, *,
     lost = False
     slip = 0.0
     max_grip = 0.0
-    n = max(1, int(round((ramp_s + hold_s) / 0.05)))
+    n = max(1, int(round((ramp_s + hold_s) / TUG_REPORT_S)))
     status = "ok"
     for _ in range(n):
         r = ex.hold((ramp_s + hold_s) / n)
@@ -349,7 +359,13 @@ def tug_test(object: str = "circle", contacts: dict | None = None, *,
 
 
 def parse_perturbation(text: str | None) -> tuple[float, float, float] | str | None:
-    """``"DX,DY,DTHETA"`` (m, m, deg) or ``"random"`` from a command line; None passes."""
+    """``"DX,DY,DTHETA"`` (m, m, deg) or ``"random"`` from a command line; None passes.
+
+    Raises
+    ------
+    GraspGaitInputError
+        Not three numbers, or one of them not finite (``nan``, ``inf``).
+    """
     if text is None or text == "random":
         return text
     parts = text.split(",")
@@ -357,11 +373,105 @@ def parse_perturbation(text: str | None) -> tuple[float, float, float] | str | N
         vals = tuple(float(p) for p in parts)
     except ValueError:
         vals = ()
-    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+    if len(vals) != 3:
         raise GraspGaitInputError(
             f"--perturb {text!r}: give DX,DY,DTHETA (metres, metres, degrees), e.g. "
             "0.004,-0.002,3, or 'random'")
+    for name, unit, v in zip(("dx", "dy", "dtheta"), ("m", "m", "deg"), vals, strict=True):
+        if not math.isfinite(v):
+            raise GraspGaitInputError(
+                f"--perturb {name}={v} {unit}: not a finite number; give DX,DY,DTHETA "
+                "(metres, metres, degrees), e.g. 0.004,-0.002,3, or 'random'")
     return vals  # type: ignore[return-value]
+
+
+def perturbation_limits(shape: Shape, config: SimConfig) -> tuple[float, float | None]:
+    """The largest initial pose error the simulated hand recovers from by design:
+    ``(offset_m, angle_deg)``; ``angle_deg`` is None when any angle will do.
+
+    - **Offset** ``min(standoff, overshoot)`` (0.010 m by default): every finger finds
+      the object along an approach line toward the expected centre (the probe's, thesis
+      7.4.2, or the grasp's without the probe), whose contact detection (7.3) is armed
+      from ``standoff`` outside the expected surface to ``overshoot`` inside it. An
+      offset moves the surface along the line by about its own length: beyond
+      ``standoff`` a finger runs into the object before detection is armed (and shoves
+      it), beyond ``overshoot`` it never reaches it.
+    - **Angle** ``probe_vertex_clearance_deg`` (8°): the probe aims that far from the
+      expected object's vertices, so a smaller turn leaves each probe finger on the
+      edge it aimed at, and the localizer's local search (7.4.5) starts within reach of
+      the true pose. A circle's orientation is never observed and touches nothing: no
+      bound (None).
+
+    Measured on the four thesis objects' optimal plans (vertex clearance 4°): 192 of
+    192 gaits succeed from offsets of 8 and 9.9 mm in eight directions at -7.9°, 0° and
+    7.9°; from 13 and 20 mm at -15°, 0° and 15°, 39 of 192 fail (no contact, drops),
+    none of them on the circle.
+    """
+    offset = min(config.standoff, config.overshoot)
+    angle = None if isinstance(shape, Circle) else config.probe_vertex_clearance_deg
+    return offset, angle
+
+
+def check_perturbation(pert: tuple[float, float, float] | str | None, shape: Shape,
+                       config: SimConfig, option: str = "--perturb") -> None:
+    """Refuse an initial pose error beyond :func:`perturbation_limits` (or not finite),
+    in one line naming the value, its unit and the bound. ``"random"`` is checked by
+    the range it draws from (up to 6 mm and 5°); None passes.
+
+    Raises
+    ------
+    GraspGaitInputError
+        The perturbation is not finite or beyond what the hand recovers from.
+    """
+    if pert is None:
+        return
+    max_off, max_ang = perturbation_limits(shape, config)
+    why_off = (f"the {max_off:g} m the approach lines can detect (contact detection runs "
+               f"from standoff={config.standoff:g} m outside the expected surface to "
+               f"overshoot={config.overshoot:g} m inside)")
+    why_ang = (f"the {max_ang or 0.0:g} deg the probe tolerates (probe_vertex_clearance_deg: "
+               "its contacts keep that far from the expected object's vertices)")
+    if isinstance(pert, str):
+        if pert != "random":
+            raise GraspGaitInputError(f"{option} {pert!r}: give DX,DY,DTHETA or 'random'")
+        if PERTURBATION_MAX_OFFSET_M > max_off:
+            raise GraspGaitInputError(
+                f"{option} random: draws offsets up to {PERTURBATION_MAX_OFFSET_M:g} m, "
+                f"beyond {why_off}; give DX,DY,DTHETA with sqrt(dx^2 + dy^2) <= {max_off:g} m")
+        if max_ang is not None and PERTURBATION_MAX_ANGLE_DEG > max_ang:
+            raise GraspGaitInputError(
+                f"{option} random: draws angles up to {PERTURBATION_MAX_ANGLE_DEG:g} deg, "
+                f"beyond {why_ang}; give DX,DY,DTHETA with |dtheta| <= {max_ang:g} deg")
+        return
+    dx, dy, dth = (float(v) for v in pert)
+    for name, unit, v in (("dx", "m", dx), ("dy", "m", dy), ("dtheta", "deg", dth)):
+        if not math.isfinite(v):
+            raise GraspGaitInputError(f"{option} {name}={v} {unit}: not a finite number")
+    off = math.hypot(dx, dy)
+    if off > max_off:
+        name, v = ("dx", dx) if abs(dx) > max_off else ("dy", dy) if abs(dy) > max_off \
+            else ("sqrt(dx^2 + dy^2)", off)
+        raise GraspGaitInputError(
+            f"{option} {name}={v:g} m: beyond {why_off}; give sqrt(dx^2 + dy^2) <= "
+            f"{max_off:g} m")
+    if max_ang is not None and abs(dth) > max_ang:
+        raise GraspGaitInputError(
+            f"{option} dtheta={dth:g} deg: beyond {why_ang}; give |dtheta| <= {max_ang:g} deg")
+
+
+def check_video_path(video: str | os.PathLike) -> Path:
+    """Refuse a ``--video`` path that :func:`simulate_plan` could not write, before the
+    run: a suffix other than ``.mp4`` (the container written), an existing directory,
+    or a folder that cannot be created or written. Creates the folder when missing.
+
+    Raises
+    ------
+    GraspGaitInputError
+        In one line, with the path and the fix.
+    """
+    from graspgait_env.outputs import check_output_path
+
+    return check_output_path("--video", video, (VIDEO_SUFFIX,))
 
 
 def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
@@ -374,16 +484,20 @@ def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
     Returns the exit status: 0 when the gait succeeded, 1 when the simulated hand
     failed it (dropped the object, missed a contact, or ended off the planned
     orientation). Bad input raises :class:`~graspgait_env.errors.GraspGaitInputError`
-    (the CLI exits 2).
+    (the CLI exits 2), all of it before the simulation runs: the plan, the config, a
+    perturbation beyond :func:`perturbation_limits` (:func:`check_perturbation`) and a
+    video path that could not be written (:func:`check_video_path`).
     """
     import json
 
     plan = Plan.load(plan_path)
+    cfg = _resolve_config(config)
     pert = parse_perturbation(perturb)
-    if video is not None and not str(video).lower().endswith(".mp4"):
-        raise GraspGaitInputError(f"--video {video!r}: give a path ending in .mp4")
+    check_perturbation(pert, load_object(plan.object), cfg)
+    if video is not None:
+        check_video_path(video)
     result = simulate_plan(plan, video=video, seed=seed, pose_perturbation=pert,
-                           config=config, progress=progress)
+                           config=cfg, progress=progress)
     print(format_result(result))
     if json_out is not None:
         text = json.dumps(result, indent=1, default=float) + "\n"
@@ -394,7 +508,7 @@ def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
 PLAN_VERTEX_CLEARANCE_DEG = 4.0  # (degrees) keep planned contacts off polygon corners
 
 
-def default_plan(object: str = "ellipse", mu: float = 0.7, planner: str = "optimal",
+def default_plan(object: str = "ellipse", mu: float = THESIS_MU, planner: str = "optimal",
                  vertex_clearance_deg: float = PLAN_VERTEX_CLEARANCE_DEG) -> Plan:
     """The 360° gait of ``object`` at ``mu`` by ``planner``
     (:mod:`graspgait_env.planners.registry`), for the physical hand: contacts stay

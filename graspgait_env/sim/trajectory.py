@@ -1,7 +1,7 @@
 """The trajectory planner (thesis 7.4.2): finger paths, grip schedules, contact normals.
 
 Each gait step becomes a short list of :class:`Trajectory` objects, all three fingers
-on one clock:
+on one clock (the sequences themselves: :mod:`~graspgait_env.sim.moves`):
 
 - **rotation** (:func:`rotation`): the fingers on the object travel arcs about the
   (estimated) object centre at their present radius, through the commanded angle; a
@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from graspgait_env.sim.frames import rotation_matrices
 
 __all__ = [
     "Trajectory",
@@ -221,11 +223,6 @@ def _n_points(length: float, res: float) -> int:
     return max(2, int(math.ceil(length / res)) + 1)
 
 
-def _rot(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, s = np.cos(a), np.sin(a)
-    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
-
-
 def rotation(x0: NDArray[np.float64], center: ArrayLike, delta_deg: float,
              moving: ArrayLike, grip: ArrayLike, normals: NDArray[np.float64], *,
              res: float, speed_deg: float, accel: float, max_speed: float | None = None,
@@ -247,7 +244,7 @@ def rotation(x0: NDArray[np.float64], center: ArrayLike, delta_deg: float,
     length = abs(d) * max(rmax, 1e-9)
     n = _n_points(length, res)
     a = np.linspace(0.0, d, n)
-    R = _rot(a)  # (n, 2, 2)
+    R = rotation_matrices(a)  # (n, 2, 2)
     paths = np.broadcast_to(x0, (n, 3, 3)).copy()
     paths[:, mv, :2] = c + np.einsum("nij,fj->nfi", R, rel[mv])
     nr = np.broadcast_to(np.asarray(normals, dtype=np.float64), (3, 2))
@@ -329,7 +326,7 @@ def approach(x0: NDArray[np.float64], fingers: ArrayLike, targets: NDArray[np.fl
     a servo transient that the contact detector would take for contact) to
     ``standoff`` before the targets, then ``approach`` (type CONTACT,
     ``approach_speed``, ``approach_accel``: contact detection armed) to the end; contact
-    detection ends the second early (the executor). The fast part is skipped for a
+    detection ends the second early (the servo loop). The fast part is skipped for a
     finger already within ``standoff``. The ``hold`` fingers keep their grip (HOLD).
     """
     x0 = np.asarray(x0, dtype=np.float64)

@@ -69,6 +69,17 @@ def test_overrides_and_replace():
     ("grip_check", "yes", "true or false"),
     ("finger_solref", [0.004], "2 numbers"),
     ("timestep", float("nan"), "finite"),
+    # the tuned numbers that once were literals in the executor
+    ("drop_tilt_deg", -5.0, "out of range"),
+    ("drop_tilt_deg", 120.0, "on its side"),
+    ("probe_margin_deg", float("inf"), "finite"),
+    ("probe_vertex_clearance_deg", -1.0, "out of range"),
+    ("probe_step_deg", 0.0, "out of range"),
+    ("recenter_speed", 0.0, "out of range"),
+    ("monitor_every", 2.5, "integer"),
+    ("monitor_every", 0, "out of range"),
+    ("object_settle_time", "long", "expected a finite number"),
+    ("video_tail_s", -0.5, "out of range"),
 ])
 def test_bad_values_are_refused_with_the_field(key, value, fragment):
     with pytest.raises(ConfigError) as e:
@@ -79,3 +90,23 @@ def test_bad_values_are_refused_with_the_field(key, value, fragment):
 def test_optional_fields_accept_null():
     cfg = load_sim_config(overrides={"finger_mu": None, "cone_mu": None, "object_mass": None})
     assert cfg.finger_mu is None
+
+
+def test_the_once_literal_numbers_keep_their_values():
+    """Tuned numbers that lived in the executor are SimConfig fields with today's values
+    (the executor's results stay bit-identical with the defaults)."""
+    cfg = SimConfig()
+    assert cfg.drop_tilt_deg == 20.0
+    assert cfg.probe_margin_deg == 10.0
+    assert cfg.probe_step_deg == 4.0 and cfg.probe_vertex_clearance_deg == 8.0
+    assert cfg.recenter_speed == cfg.approach_speed * 2  # exactly, in floating point
+    assert cfg.monitor_every == 5 and cfg.object_settle_time == 0.05
+    assert int(cfg.video_tail_s * cfg.video_fps) == cfg.video_fps // 2
+
+
+def test_every_yaml_value_has_a_reason():
+    """Each key's line (or the comment lines under it) carries a comment."""
+    lines = DEFAULT_SIM_CONFIG.read_text().splitlines()
+    for f in fields(SimConfig):
+        i = next(k for k, ln in enumerate(lines) if ln.startswith(f"{f.name}:"))
+        assert "#" in lines[i], f"{f.name}: no reason given in {DEFAULT_SIM_CONFIG.name}"
