@@ -8,9 +8,10 @@ Ids (registered by :func:`register_envs`, which ``import graspgait_env`` calls):
 - ``GraspGaitMujoco-v0`` (:class:`GraspGaitMujocoEnv`): the same spaces, each move
   executed on the MuJoCo hand by the thesis controller (ch. 7).
 
-The environment classes are imported lazily (``from graspgait_env.envs import
-GraspGaitEnv`` works), so importing this package costs no more than Gymnasium's
-registry.
+The keyword arguments the three ids share are one frozen dataclass,
+:class:`GraspGaitConfig` (``config=`` or its fields as keywords). The environment
+classes are imported lazily (``from graspgait_env.envs import GraspGaitEnv`` works), so
+importing this package costs no more than Gymnasium's registry.
 """
 
 from __future__ import annotations
@@ -21,15 +22,19 @@ from graspgait_env.envs.registration import ENV_IDS, register_envs
 
 __all__ = [
     "ENV_IDS",
+    "GraspGaitConfig",
     "GraspGaitEnv",
     "GraspGaitMujocoEnv",
     "GraspGaitRandomEnv",
+    "ResetNeededError",
     "register_envs",
     "state_from_observation",
 ]
 
 _LAZY = {
+    "GraspGaitConfig": "graspgait_env.envs.config",
     "GraspGaitEnv": "graspgait_env.envs.map_env",
+    "ResetNeededError": "graspgait_env.envs.map_env",
     "state_from_observation": "graspgait_env.envs.map_env",
     "GraspGaitRandomEnv": "graspgait_env.envs.random_env",
     "GraspGaitMujocoEnv": "graspgait_env.envs.mujoco_env",

@@ -4,19 +4,33 @@ The environment is the discretized gait problem of :class:`graspgait_env.gait.Ga
 (states, moves, action layout and legal-move function) with an observation, a reward
 made of named terms and episode ends. See :class:`GraspGaitEnv` for the documentation
 page; :func:`state_from_observation` recovers the exact gait state from an observation.
+The keyword arguments shared by the env family are
+:class:`~graspgait_env.envs.config.GraspGaitConfig`.
 """
 
 from __future__ import annotations
 
+import inspect
 import math
-from typing import Any
+import os
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
-from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.envs.config import (
+    GraspGaitConfig,
+    check_mu,
+    check_object,
+    check_options,
+    check_seed,
+    env_id_of,
+)
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.gait import REGRASP, ROTATE, GaitModel, GaitState
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand
 
@@ -24,6 +38,7 @@ __all__ = [
     "GraspGaitEnv",
     "ObservationLayout",
     "REWARD_TERMS",
+    "ResetNeededError",
     "state_from_observation",
 ]
 
@@ -66,17 +81,13 @@ class ObservationLayout:
         self.size = _HEADER + n_actions + cells * cells
 
 
-def _finite(name: str, v: Any, *, positive: bool = False, nonneg: bool = False) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name}={v!r}: must be a number")
-    v = float(v)
-    if not math.isfinite(v):
-        raise ValueError(f"{name}={v!r}: must be finite")
-    if positive and not v > 0:
-        raise ValueError(f"{name}={v!r}: must be > 0")
-    if nonneg and v < 0:
-        raise ValueError(f"{name}={v!r}: must be >= 0 (it is subtracted as a penalty)")
-    return v
+class ResetNeededError(gym.error.ResetNeeded, RuntimeError):
+    """A call that needs an episode (``step``, ``action_masks``, ``state``, ``render``)
+    came before the first ``reset()`` (or after a ``reset()`` that raised).
+
+    Both Gymnasium's ``ResetNeeded`` (what ``gymnasium.make``'s order enforcing raises)
+    and a ``RuntimeError``.
+    """
 
 
 def _pooled_map(stable: NDArray[np.bool_], s: int) -> NDArray[np.float32]:
@@ -95,6 +106,14 @@ def _pooled_map(stable: NDArray[np.bool_], s: int) -> NDArray[np.float32]:
     return out
 
 
+def _contact_at(model: GaitModel, finger: int, p: int, k: int) -> int:
+    """The contact that ``finger`` touches at workspace position ``p`` when the object is at
+    ``k``: the contact a regrasp of the (free) finger to position ``p`` places it on,
+    as :meth:`GaitModel.decode` computes it (action layout: ``2R + 2p + l``)."""
+    probe = GaitState(k, tuple(-1 if i == finger else 0 for i in range(3)))
+    return model.decode(probe, 2 * model.R + 2 * p).contact
+
+
 def state_from_observation(obs: NDArray[np.floating], model: GaitModel,
                            turn_deg: float) -> GaitState:
     """The exact :class:`GaitState` that produced ``obs`` (a GraspGait observation).
@@ -107,9 +126,8 @@ def state_from_observation(obs: NDArray[np.floating], model: GaitModel,
     cs = [-1, -1, -1]
     for f in range(3):
         if obs[_HELD + f] > 0.5:
-            w = max(int(model.ws_width[f]) - 1, 1)
-            p = int(round(float(obs[_POS + f]) * w))
-            cs[f] = int((int(model.ws_start[f]) + p - k) % model.n)
+            w = max(int(model.ws_width[f]) - 1, 1)  # the observation's scale, p / (W_f - 1)
+            cs[f] = _contact_at(model, f, int(round(float(obs[_POS + f]) * w)), k)
     return GaitState(k, tuple(cs))
 
 
@@ -142,8 +160,16 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     Legal actions: :meth:`action_masks` (the sb3-contrib ``MaskablePPO`` protocol) and
     ``info["action_mask"]`` give exactly ``model.action_mask(state)`` (a bool array).
     **An illegal action** (a valid index that is not a legal move) leaves the state as it
-    is and costs the ``illegal`` reward term; it never raises. An index outside the
-    action space raises ``ValueError``.
+    is and costs the ``illegal`` reward term; it never raises. An action is a Python
+    ``int``, a NumPy integer (what SB3 and Gymnasium vector envs pass) or a 0-d integer
+    array (SB3's ``predict`` on one observation); anything else (a float such as ``2.0``,
+    a string, ``None``, a bool, a list or a 1-element array) raises ``ValueError``
+    (:class:`~graspgait_env.errors.GraspGaitInputError`) naming the value, as does an
+    index outside the action space. Bools are refused although Gymnasium's ``Discrete``
+    contains ``True``: an action given as a bool is a mask entry passed by mistake.
+    ``step`` (and ``action_masks``, ``state``, ``render``) before the first ``reset``
+    raises :class:`ResetNeededError` (a ``gymnasium.error.ResetNeeded`` and a
+    ``RuntimeError``).
 
     ## Observation Space
 
@@ -191,7 +217,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     The thesis's path metric ``M = αθ - βη - γr`` (5.4: θ the object angle, η regrasps,
     r rotations) paid step by step, plus episode-end terms. Each step's terms are in
     ``info["reward_terms"]`` (a dict, always all six keys, in this order) and the reward
-    is their sum, computed in this order (so ``reward == sum(terms.values())`` exactly):
+    is their sum, computed in this order (so ``reward == sum(terms.values())`` exactly),
+    by one method, ``_reward``, which ``GraspGaitMujoco-v0`` shares:
 
     | Term        | Value                                                                     |
     |-------------|---------------------------------------------------------------------------|
@@ -214,7 +241,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     least one legal move. No check is made that a gait exists from it: on objects where
     none does (e.g. the triangle at mu = 0.7), episodes end in dead ends or at the time
     limit. ``reset(options={"start": {1: 50.0, 3: 270.0}})`` (finger number → contact in
-    degrees, or a :class:`GaitState` at k = 0) starts from a given grasp.
+    degrees, or a :class:`GaitState` at k = 0) starts from a given grasp. ``"start"`` is
+    the only option; an unknown key raises ``ValueError`` naming it. ``seed`` is None or
+    an integer >= 0 (a NumPy integer is taken as its value; a bool is refused).
 
     ## Episode End
 
@@ -231,16 +260,21 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     ## Arguments
 
-    ``gymnasium.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7, hand=None,
-    turn_deg=360.0, n=180, alpha=1.0, beta=0.01, gamma=0.01, turn_scale_deg=None,
-    success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1, max_backward_deg=360.0,
-    map_window_deg=360.0, map_window_cells=36, render_mode=None)``
+    ``gymnasium.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7, *,
+    config=None, render_mode=None, **fields)``, where ``fields`` are those of
+    :class:`~graspgait_env.envs.config.GraspGaitConfig` (each documented there, with its
+    units): ``hand=None, turn_deg=360.0, n=180, alpha=1.0, beta=0.01, gamma=0.01,
+    turn_scale_deg=None, success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1,
+    max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36``.
 
     - ``object``: bundled name (``"ellipse"``, the thesis's fig. 5.3 ellipse), YAML path
       or :class:`~graspgait_env.shapes.Shape`.
-    - ``mu``: Coulomb friction; ``hand``: bundled hand name, YAML path or
-      :class:`~graspgait_env.workspace.Hand` (default: thesis fig. 4.1).
-    - ``turn_deg``: requested turn (sign = direction); ``n``: grid size.
+    - ``mu``: Coulomb friction (> 0).
+    - ``config``: a :class:`~graspgait_env.envs.config.GraspGaitConfig`; keyword
+      ``fields`` given as well replace its values.
+    - ``hand``: bundled hand name, YAML path or :class:`~graspgait_env.workspace.Hand`
+      (default: thesis fig. 4.1); ``turn_deg``: requested turn (sign = direction);
+      ``n``: grid size.
     - ``alpha, beta, gamma, turn_scale_deg`` (default ``abs(turn_deg)``),
       ``success_bonus, dead_end_penalty, illegal_penalty``: reward weights (above).
     - ``max_backward_deg``: wrong-way limit (above).
@@ -251,113 +285,111 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
       shows the same frame in a matplotlib window when an interactive backend is
       available; headless (Agg backend, no display) it shows nothing and warns once.
 
+    Every argument is checked at construction: a bad value raises ``ValueError``
+    (:class:`~graspgait_env.errors.GraspGaitInputError`) naming it, the value and the
+    fix (``mu='abc': must be a finite number > 0, e.g. 0.7``); a misspelled keyword
+    raises naming it and listing the valid ones. The config is ``env.config``; each of
+    its fields also reads as a read-only attribute (``env.beta``); ``env.turn_scale_deg``
+    and ``env.hand`` are resolved (``abs(turn_deg)`` when None; the loaded
+    :class:`~graspgait_env.workspace.Hand`).
+
     ## Version History
 
     - v0: initial version.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 4}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"],
+                                          "render_fps": 4}
+    _RESET_OPTIONS: ClassVar[tuple[str, ...]] = ("start",)  # reset(options=...) keys
+    _ARG_HINTS: ClassVar[dict[str, str]] = {}  # advice for a keyword that is not an argument
 
     def __init__(
         self,
-        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (docs/cli.md OBJECT)
+        object: str | os.PathLike | Shape = "ellipse",  # noqa: A002 - the user-facing name
         mu: float = 0.7,
-        hand: str | Hand | None = None,
-        turn_deg: float = 360.0,
-        n: int = 180,
         *,
-        alpha: float = 1.0,
-        beta: float = 0.01,
-        gamma: float = 0.01,
-        turn_scale_deg: float | None = None,
-        success_bonus: float = 1.0,
-        dead_end_penalty: float = 1.0,
-        illegal_penalty: float = 0.1,
-        max_backward_deg: float = 360.0,
-        map_window_deg: float = 360.0,
-        map_window_cells: int = 36,
+        config: GraspGaitConfig | None = None,
         render_mode: str | None = None,
+        **fields: Any,
     ) -> None:
-        self._configure(turn_deg=turn_deg, alpha=alpha, beta=beta, gamma=gamma,
-                        turn_scale_deg=turn_scale_deg, success_bonus=success_bonus,
-                        dead_end_penalty=dead_end_penalty, illegal_penalty=illegal_penalty,
-                        max_backward_deg=max_backward_deg, map_window_deg=map_window_deg,
-                        map_window_cells=map_window_cells, render_mode=render_mode)
-        self._use_model(GaitModel(object, mu, hand, n))
+        self._configure(config, render_mode, fields)
+        self._use_model(GaitModel(check_object(object), check_mu(mu), self.config.hand,
+                                  self.config.n))
         self._make_spaces()
 
     # ------------------------------------------------------------------ set-up
-    def _configure(self, *, turn_deg, alpha, beta, gamma, turn_scale_deg, success_bonus,
-                   dead_end_penalty, illegal_penalty, max_backward_deg, map_window_deg,
-                   map_window_cells, render_mode) -> None:
+    def _configure(self, config: GraspGaitConfig | None, render_mode: str | None,
+                   fields: Mapping[str, Any]) -> None:
+        """Check and store the config (``config`` with ``fields`` replaced) and the
+        render mode; the env needs ``reset()`` before ``step``."""
+        owner = env_id_of(type(self))
+        params = inspect.signature(type(self).__init__).parameters.values()
+        own = [p.name for p in params if p.name != "self"
+               and p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)]
+        self.config = GraspGaitConfig.merged(config, fields, owner=owner, other_args=own,
+                                             hints=self._ARG_HINTS)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode={render_mode!r}: use None, "
-                             f"{' or '.join(map(repr, self.metadata['render_modes']))}")
+            raise GraspGaitInputError(
+                f"render_mode={render_mode!r}: use None, "
+                f"{' or '.join(map(repr, self.metadata['render_modes']))}")
         self.render_mode = render_mode
-        self.turn_deg = _finite("turn_deg", turn_deg)
-        if self.turn_deg == 0:
-            raise ValueError("turn_deg=0: ask for a nonzero turn, e.g. 360 (CCW) or -360 (CW)")
-        self.alpha = _finite("alpha", alpha)
-        self.beta = _finite("beta", beta, nonneg=True)
-        self.gamma = _finite("gamma", gamma, nonneg=True)
-        self.turn_scale_deg = (abs(self.turn_deg) if turn_scale_deg is None
-                               else _finite("turn_scale_deg", turn_scale_deg, positive=True))
-        self.success_bonus = _finite("success_bonus", success_bonus)
-        self.dead_end_penalty = _finite("dead_end_penalty", dead_end_penalty, nonneg=True)
-        self.illegal_penalty = _finite("illegal_penalty", illegal_penalty, nonneg=True)
-        self.max_backward_deg = _finite("max_backward_deg", max_backward_deg, positive=True)
-        self.map_window_deg = _finite("map_window_deg", map_window_deg, positive=True)
-        if self.map_window_deg > 360.0:
-            raise ValueError(f"map_window_deg={map_window_deg!r}: at most 360 (the whole map)")
-        if (isinstance(map_window_cells, bool) or not isinstance(map_window_cells, int)
-                or map_window_cells < 1):
-            raise ValueError(f"map_window_cells={map_window_cells!r}: must be an integer >= 1")
-        self.map_window_cells = int(map_window_cells)
-        self._fig = None
-        self._human_warned = False
+        self._renderer = None  # render.GaitRenderer, made by the first human-mode render()
+        self._mask: NDArray[np.bool_] | None = None  # None: reset() needed
         self.model: GaitModel
+
+    @property
+    def turn_scale_deg(self) -> float:
+        """Degrees of turn that earn ``alpha``: ``config.turn_scale_deg`` or ``abs(turn_deg)``."""
+        return self.config.turn_scale
+
+    @property
+    def hand(self) -> Hand:
+        """The hand (loaded: a :class:`~graspgait_env.workspace.Hand`; ``config.hand`` is
+        what was given)."""
+        return self.model.hand
 
     def _use_model(self, model: GaitModel) -> None:
         """Bind a gait model: precompute every per-model table that ``step`` reads."""
+        cfg = self.config
         self.model = model
         n = model.n
         self._n = n
-        self._R = int(model.R)
         self._A = int(model.n_actions)
-        self._S = [int(x) for x in model.ws_start]
-        self._W = [int(x) for x in model.ws_width]
-        self._inv_w = [1.0 / max(w - 1, 1) for w in self._W]
+        # observation scale of a workspace position: p / (W_f - 1)
+        self._inv_w = [1.0 / max(int(w) - 1, 1) for w in model.ws_width]
         self._step_deg = model.step_deg
-        self._K = model.turn_steps(self.turn_deg)
+        self._K = model.turn_steps(cfg.turn_deg)
         self._sign = 1 if self._K > 0 else -1
         self._Kabs = abs(self._K)
         if self._Kabs == 0:
-            raise ValueError(f"turn_deg={self.turn_deg!r}: rounds to no grid step at n={n}")
-        self._back = model.turn_steps(self.max_backward_deg)
-        self._turn_coef = self.alpha * self._step_deg / self.turn_scale_deg
+            raise GraspGaitInputError(
+                f"turn_deg={cfg.turn_deg!r}: rounds to no grid step at n={n}; ask for at "
+                f"least {self._step_deg:g} degrees")
+        self._back = model.turn_steps(cfg.max_backward_deg)
+        self._turn_coef = cfg.alpha * self._step_deg / cfg.turn_scale
+        # GaitModel.decode of every rotation (a rotation's delta does not depend on the
+        # state, so it is decoded once per model; 0: the action is a regrasp)
+        probe = GaitState(0, (0, 0, -1))
+        self._delta = [m.delta if m.kind == ROTATE else 0
+                       for m in (model.decode(probe, a) for a in range(self._A))]
         phi = 2.0 * math.pi * np.arange(n) / n
         self._cos = np.cos(phi).tolist()
         self._sin = np.sin(phi).tolist()
-        cells = self.map_window_cells
-        span = max(1, round(self.map_window_deg / self._step_deg))
-        s = max(1, span // cells)
-        if s * cells > n:
-            raise ValueError(
-                f"map_window_cells={cells}: more cells than grid points in "
-                f"map_window_deg={self.map_window_deg:g} at n={n}; use at most "
-                f"{max(1, min(n, span))} cells")
+        cells = cfg.map_window_cells
+        s = cfg.window_stride()
         self._stride = s
         self._win_back = s * (cells // 2) + s // 2
+        self._win_len = s * cells
         self._pooled = _pooled_map(model.stable, s)
         self._starts: list[GaitState] | None = None
 
     def _make_spaces(self) -> None:
-        A, C = self._A, self.map_window_cells
+        A, C = self._A, self.config.map_window_cells
         self.layout = ObservationLayout(A, C)
         lo = np.zeros(self.layout.size, dtype=np.float64)
         hi = np.ones(self.layout.size, dtype=np.float64)
         lo[_POS:_THETA + 2] = -1.0
-        R, K, B = self._R, self._Kabs, self._back
+        R, K, B = int(self.model.R), self._Kabs, self._back  # R: the longest rotation
         lo[_ACHIEVED], hi[_ACHIEVED] = -(B + R) / K, (K + R) / K
         lo[_TO_GO], hi[_TO_GO] = 0.0, (K + B + R) / K
         self.observation_space = spaces.Box(lo.astype(np.float32), hi.astype(np.float32),
@@ -369,39 +401,51 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _check_model_fits(self, model: GaitModel) -> None:
         if int(model.n_actions) != self.action_space.n or model.n != self._n:
-            raise ValueError(
+            raise GraspGaitInputError(
                 f"object {model.shape.name!r}: its gait model has {model.n_actions} actions "
                 f"at n={model.n}, the env's spaces {self.action_space.n} at n={self._n}; "
                 "keep n and the hand's workspaces fixed")
 
     # ------------------------------------------------------------------ state
+    def _reset_needed(self, what: str) -> ResetNeededError:
+        return ResetNeededError(f"{what}: call reset() first (no episode has started, or "
+                                "the last reset() raised)")
+
     @property
     def state(self) -> GaitState:
         """The present gait state ``(k, contacts)`` (a fresh tuple)."""
-        return GaitState(self._k, tuple(self._c))
+        if self._mask is None:
+            raise self._reset_needed("state")
+        return GaitState(self._k, self._c)
 
     def action_masks(self) -> NDArray[np.bool_]:
         """Legal actions of the present state (sb3-contrib MaskablePPO protocol).
 
         Exactly ``self.model.action_mask(self.state)``. A fresh array per step; do not
         write into it.
+
+        Raises
+        ------
+        ResetNeededError
+            Before the first ``reset()``.
         """
-        return self._mask
+        mask = self._mask
+        if mask is None:
+            raise self._reset_needed("action_masks")
+        return mask
 
     def _set_state(self, s: GaitState) -> None:
-        self._k = int(s.k)
-        self._c = [int(x) for x in s.contacts]
-        held = [f for f in range(3) if self._c[f] >= 0]
-        self._f, self._g = held
-        self._h = 3 - held[0] - held[1]
-        self._p = [-1, -1, -1]
-        for f in held:
-            self._p[f] = (self._c[f] + self._k - self._S[f]) % self._n
+        self._k = k = int(s.k)
+        self._c = c = tuple(int(x) for x in s.contacts)  # contacts, a tuple (-1: free)
+        self._f, self._g = s.held()
+        self._h = 3 - self._f - self._g  # the free finger
+        # workspace position of each finger's contact (GaitModel.position; -1: free)
+        self._p = [self.model.position(f, c[f], k) if c[f] >= 0 else -1 for f in range(3)]
 
     def _compute_mask(self) -> NDArray[np.bool_]:
         """The legal moves of the present state: ``model.action_mask`` (THE legal-move
         function; a fresh array each call)."""
-        return self.model.action_mask(GaitState(self._k, tuple(self._c)))
+        return self.model.action_mask(GaitState(self._k, self._c))
 
     # ------------------------------------------------------------------ observation
     def _write_grasp(self) -> None:
@@ -417,26 +461,69 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 o[_POS + f] = -1.0
                 o[_PHI + 2 * f] = 0.0
                 o[_PHI + 2 * f + 1] = 0.0
-        n, wb, s, L = self._n, self._win_back, self._stride, self._stride * self.map_window_cells
+        n, wb, s, L = self._n, self._win_back, self._stride, self._win_len
         i0 = (c[self._f] - wb) % n
         j0 = (c[self._g] - wb) % n
         self._win_view[...] = self._pooled[i0:i0 + L:s, j0:j0 + L:s]
 
     def _write_motion(self) -> None:
         """Observation entries that change with every move."""
-        o, f, g = self._obs, self._f, self._g
+        o, f, g, k = self._obs, self._f, self._g, self._k
         o[_POS + f] = self._p[f] * self._inv_w[f]
         o[_POS + g] = self._p[g] * self._inv_w[g]
-        km = self._k % self._n
+        km = k % self._n
         o[_THETA] = self._cos[km]
         o[_THETA + 1] = self._sin[km]
-        t = self._sign * self._k
+        t = self._sign * k
         o[_ACHIEVED] = t / self._Kabs
         o[_TO_GO] = max(0, self._Kabs - t) / self._Kabs
         self._mask_view[...] = self._mask
 
+    # ------------------------------------------------------------------ reward
+    def _reward(self, k0: int, k1: int, move: str | None, ends: bool,
+                is_success: bool) -> tuple[float, dict[str, float]]:
+        """The reward of one step and its named terms (the *Rewards* table).
+
+        Parameters
+        ----------
+        k0, k1
+            Object angle before and after the step (grid steps).
+        move
+            :data:`~graspgait_env.gait.ROTATE` or :data:`~graspgait_env.gait.REGRASP`
+            (the gait module's constants: the move made, or attempted and failed in
+            physics), ``None`` for an illegal action (a no-op).
+        ends
+            The episode ends at this step for the first time (pays ``success`` or
+            ``dead_end``).
+        is_success
+            The turn is reached.
+
+        Returns
+        -------
+        reward, terms
+            ``terms`` in :data:`REWARD_TERMS` order; ``reward`` is their sum in that
+            order, so ``reward == sum(terms.values())`` exactly.
+        """
+        cfg = self.config
+        K = self._Kabs
+        t0, t1 = self._sign * k0, self._sign * k1
+        # thesis 5.4: alpha * theta, the turn towards the goal, overshoot earning nothing
+        turn = self._turn_coef * ((t1 if t1 < K else K) - (t0 if t0 < K else K))
+        regrasp = -cfg.beta if move is REGRASP else 0.0  # thesis 5.4: - beta * regrasps
+        rotation = -cfg.gamma if move is ROTATE else 0.0  # thesis 5.4: - gamma * rotations
+        illegal = -cfg.illegal_penalty if move is None else 0.0
+        success = dead_end = 0.0
+        if ends:
+            if is_success:
+                success = cfg.success_bonus
+            else:
+                dead_end = -cfg.dead_end_penalty
+        reward = turn + regrasp + rotation + success + dead_end + illegal
+        return reward, {"turn": turn, "regrasp": regrasp, "rotation": rotation,
+                        "success": success, "dead_end": dead_end, "illegal": illegal}
+
     # ------------------------------------------------------------------ API
-    def _on_reset(self, options: dict[str, Any]) -> GaitState | None:
+    def _on_reset(self, options: Mapping[str, Any]) -> GaitState | None:
         """Hook for subclasses: choose the model for the new episode (here: keep it).
 
         May return a start state already drawn for the new model (else ``None``).
@@ -448,7 +535,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._starts = self.model.start_states()
         starts = self._starts
         if not starts:
-            raise ValueError(
+            raise GraspGaitInputError(
                 f"object {self.model.shape.name!r} at mu={self.model.mu:g}: no legal grasp at "
                 "theta = 0 with this hand; raise mu or change the hand")
         rng = self.np_random
@@ -463,26 +550,47 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._set_state(s)
             if self._compute_mask().any():
                 return s
-        raise ValueError(
+        raise GraspGaitInputError(
             f"object {self.model.shape.name!r} at mu={self.model.mu:g}: every legal start "
             f"grasp ({len(starts)}) is a dead end; raise mu or change the hand")
 
     def _parse_start(self, start: Any) -> GaitState:
+        fix = ("give {finger: phi_deg} for two fingers, e.g. {1: 50.0, 3: 270.0}, or a "
+               "GaitState at k = 0")
         if isinstance(start, GaitState):
-            s = GaitState(int(start.k), tuple(int(c) for c in start.contacts))
+            try:
+                s = GaitState(int(start.k), tuple(int(c) for c in start.contacts))
+            except (TypeError, ValueError):
+                raise GraspGaitInputError(f"options['start']={start!r}: {fix}") from None
             if s.k != 0 or not self.model.is_legal_state(s):
-                raise ValueError(f"options['start']={start!r}: must be a legal state at k = 0")
+                raise GraspGaitInputError(
+                    f"options['start']={start!r}: must be a legal state at k = 0")
             return s
-        if isinstance(start, dict):
-            return self.model.start_state({int(f): float(v) for f, v in start.items()})
-        raise ValueError(f"options['start']={start!r}: give {{finger: phi_deg}} for two "
-                         "fingers, e.g. {1: 50.0, 3: 270.0}, or a GaitState at k = 0")
+        if isinstance(start, Mapping):
+            try:
+                contacts = {int(f): float(v) for f, v in start.items()}
+            except (TypeError, ValueError):
+                raise GraspGaitInputError(f"options['start']={start!r}: {fix}") from None
+            try:
+                return self.model.start_state(contacts)
+            except GraspGaitInputError as exc:
+                raise GraspGaitInputError(f"options['start']={start!r}: {exc}") from None
+        raise GraspGaitInputError(f"options['start']={start!r}: {fix}")
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[NDArray[np.float32], dict]:
-        """Start an episode at θ = 0 (see *Starting State*); returns ``(obs, info)``."""
+        """Start an episode at θ = 0 (see *Starting State*); returns ``(obs, info)``.
+
+        Raises
+        ------
+        GraspGaitInputError
+            A bad ``seed``, an unknown option or a bad start grasp (the message names
+            it); the env then needs another ``reset()`` before ``step``.
+        """
+        seed = check_seed(seed)
+        options = check_options(options, self._RESET_OPTIONS, env_id_of(type(self)))
+        self._mask = None  # until this reset succeeds
         super().reset(seed=seed)
-        options = {} if options is None else options
         s = self._on_reset(options)
         start = options.get("start")
         if start is not None:
@@ -490,13 +598,15 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         elif s is None:
             s = self._draw_start()
         self._set_state(s)
-        self._mask = self._compute_mask()
-        if not self._mask.any():
-            raise ValueError(f"options['start']={start!r}: this grasp has no legal move")
+        mask = self._compute_mask()
+        if not mask.any():
+            raise GraspGaitInputError(
+                f"options['start']={start!r}: this grasp has no legal move")
+        self._mask = mask
         self._regrasps = 0
         self._rotations = 0
         self._terminal = False
-        self._trail: list[tuple[int, tuple[int, ...]]] = [(self._k, tuple(self._c))]
+        self._trail: list[tuple[int, tuple[int, ...]]] = [(self._k, self._c)]
         self._write_grasp()
         self._write_motion()
         info = {"action_mask": self._mask, "is_success": False, "turn_deg": 0.0,
@@ -505,60 +615,79 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             self.render()
         return self._obs.copy(), info
 
-    def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
-        """Apply one move; see the class docstring for rewards and episode ends."""
-        a = int(action)
+    def _action_index(self, action: Any) -> int:
+        """``action`` as an index into the action space (see *Action Space*), or raise."""
+        if self._mask is None:
+            raise self._reset_needed("step")
+        t = type(action)
+        if t is int or t is np.int64:  # the common cases first: a Python int, SB3's int64
+            a = int(action)
+        elif (isinstance(action, (int, np.integer))
+              and not isinstance(action, (bool, np.bool_))):
+            a = int(action)
+        elif isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu":
+            a = int(action)
+        else:
+            why = ("a bool is not an action index" if isinstance(action, (bool, np.bool_))
+                   else "must be an integer action index (a Python int, a NumPy integer or a "
+                   "0-d integer array)")
+            raise GraspGaitInputError(
+                f"action={action!r}: {why}; give an integer in 0..{self._A - 1}, e.g. "
+                "int(np.flatnonzero(info['action_mask'])[0])")
         if not 0 <= a < self._A:
-            raise ValueError(f"action={action!r}: outside the action space 0..{self._A - 1}")
+            raise GraspGaitInputError(
+                f"action={action!r}: outside the action space 0..{self._A - 1}")
+        return a
+
+    def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
+        """Apply one move; see the class docstring for actions, rewards and episode ends."""
+        t = type(action)
+        if (t is int or t is np.int64) and self._mask is not None:
+            a = int(action)  # the common case (SB3 and vector envs pass NumPy int64)
+            if not 0 <= a < self._A:
+                a = self._action_index(action)  # raises, naming the action
+        else:
+            a = self._action_index(action)
         k0 = self._k
-        regrasp = rotation = success = dead_end = illegal = 0.0
         if self._mask[a]:
-            R = self._R
-            if a < 2 * R:
-                d = a + 1 if a < R else R - 1 - a
+            d = self._delta[a]
+            if d:  # rotate by d grid steps: the contacts stay, each moves d through its workspace
+                move = ROTATE
                 self._k = k0 + d
                 self._p[self._f] += d
                 self._p[self._g] += d
-                rotation = -self.gamma
                 self._rotations += 1
-            else:
-                pos, lift = divmod(a - 2 * R, 2)
-                h = self._h
-                f, g = self._f, self._g
-                lifted, kept = (f, g) if lift == 0 else (g, f)
-                self._c[h] = (self._S[h] + pos - k0) % self._n
-                self._p[h] = pos
-                self._c[lifted] = -1
+            else:  # regrasp: the free finger to m.contact, m.lifted lifted (GaitModel.decode)
+                move = REGRASP
+                m = self.model.decode(GaitState(k0, self._c), a)
+                h, lifted = m.finger, m.lifted
+                kept = self._f + self._g - lifted
+                c = list(self._c)
+                c[h] = m.contact
+                c[lifted] = -1
+                self._c = tuple(c)
+                self._p[h] = self.model.position(h, m.contact, k0)
                 self._p[lifted] = -1
                 self._f, self._g = (h, kept) if h < kept else (kept, h)
                 self._h = lifted
-                regrasp = -self.beta
                 self._regrasps += 1
                 self._write_grasp()
             self._mask = self._compute_mask()
             self._write_motion()
             if self.render_mode is not None:
-                self._trail.append((self._k, tuple(self._c)))
+                self._trail.append((self._k, self._c))
         else:
-            illegal = -self.illegal_penalty
+            move = None
             self._mask = self._mask.copy()  # every info gets its own array
         t1 = self._sign * self._k
-        t0 = self._sign * k0
-        K = self._Kabs
-        turn = self._turn_coef * ((t1 if t1 < K else K) - (t0 if t0 < K else K))
-        is_success = t1 >= K
+        is_success = t1 >= self._Kabs
         terminated = is_success or t1 < -self._back or not self._mask.any()
-        if terminated and not self._terminal:
-            if is_success:
-                success = self.success_bonus
-            else:
-                dead_end = -self.dead_end_penalty
+        reward, terms = self._reward(k0, self._k, move, terminated and not self._terminal,
+                                     is_success)
         self._terminal = terminated
-        reward = turn + regrasp + rotation + success + dead_end + illegal
         info = {
             "action_mask": self._mask,
-            "reward_terms": {"turn": turn, "regrasp": regrasp, "rotation": rotation,
-                             "success": success, "dead_end": dead_end, "illegal": illegal},
+            "reward_terms": terms,
             "is_success": is_success,
             "turn_deg": self._k * self._step_deg,
             "regrasps": self._regrasps,
@@ -576,36 +705,44 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 "Set render_mode='rgb_array' or 'human' at construction, e.g. "
                 'gymnasium.make("graspgait_env:GraspGait-v0", render_mode="rgb_array")')
             return None
+        if self._mask is None:
+            raise self._reset_needed("render")
         from graspgait_env.envs import render
 
+        args = (self.model, self._trail, self.config.turn_deg, self._regrasps)
         if self.render_mode == "rgb_array":
-            return render.render_frame(self)
-        if render.can_show(self):
-            render.show_human(self, render.render_frame(self))
+            return render.render_frame(*args)
+        if self._renderer is None:
+            self._renderer = render.GaitRenderer(self.metadata["render_fps"])
+        self._renderer.show(*args)
         return None
 
     def close(self) -> None:
         """Close the human-mode window, if any (idempotent)."""
-        fig, self._fig = self._fig, None
-        if fig is not None:
-            try:
-                import matplotlib.pyplot as plt
-
-                plt.close(fig)
-            except Exception:  # noqa: BLE001 - closing must never fail
-                pass
+        if self._renderer is not None:
+            self._renderer.close()
 
     def __getstate__(self) -> dict[str, Any]:
         d = self.__dict__.copy()
-        d["_fig"] = None  # a matplotlib window is not picklable; reopened on demand
-        d.pop("_fig_img", None)
-        d.pop("_fig_im", None)
-        d.pop("_win_view", None)
+        d.pop("_win_view", None)  # views into _obs, rebuilt on unpickling
         d.pop("_mask_view", None)
         return d
 
     def __setstate__(self, d: dict[str, Any]) -> None:
         self.__dict__.update(d)
-        C = self.map_window_cells
+        C = self.config.map_window_cells
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
+
+
+def _config_property(name: str) -> property:
+    return property(lambda self: getattr(self.config, name),
+                    doc=f"``config.{name}`` (read-only; see :class:`GraspGaitConfig`).")
+
+
+# Every config field reads as an attribute of the env (``env.beta``), read-only, from the
+# one list of fields; ``hand`` and ``turn_scale_deg`` are resolved properties above.
+for _name in GraspGaitConfig.field_names():
+    if _name not in vars(GraspGaitEnv):
+        setattr(GraspGaitEnv, _name, _config_property(_name))
+del _name

@@ -8,18 +8,21 @@ turned into plan steps and executed on the simulated hand by the thesis controll
 
 from __future__ import annotations
 
+import os
+from collections.abc import Mapping
 from typing import Any
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from graspgait_env.envs.map_env import REWARD_TERMS, GraspGaitEnv, _finite
-from graspgait_env.gait import ROTATE, GaitState
+from graspgait_env.envs.config import GraspGaitConfig, check_number
+from graspgait_env.envs.map_env import GraspGaitEnv
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.gait import REGRASP, ROTATE, GaitState
 from graspgait_env.shapes import Shape
 from graspgait_env.sim.config import SimConfig, load_sim_config
 from graspgait_env.sim.executor import GaitExecutor, StepReport, random_pose_perturbation
-from graspgait_env.workspace import Hand
 
 __all__ = ["GraspGaitMujocoEnv", "MUJOCO_WARNINGS"]
 
@@ -77,10 +80,11 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     ## Rewards
 
-    The six terms of ``GraspGait-v0`` (``REWARD_TERMS``), summed in the same order;
-    ``reward == sum(info["reward_terms"].values())`` exactly. A move that ends in a
-    drop, a failed contact or a MuJoCo warning costs its move term (``regrasp`` or
-    ``rotation``) and ``dead_end``; it earns no ``turn``.
+    The six terms of ``GraspGait-v0`` (``REWARD_TERMS``), from the same method
+    (``_reward``), summed in the same order; ``reward ==
+    sum(info["reward_terms"].values())`` exactly. A move that ends in a drop, a failed
+    contact or a MuJoCo warning costs its move term (``regrasp`` or ``rotation``) and
+    ``dead_end``; it earns no ``turn``.
 
     ## Starting State
 
@@ -123,13 +127,14 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     ## Arguments
 
-    ``gymnasium.make("graspgait_env:GraspGaitMujoco-v0", object="ellipse", mu=0.7,
-    hand=None, turn_deg=360.0, n=180, sim_config=None, pose_noise=(0.0, 0.0), **kw)``
+    ``gymnasium.make("graspgait_env:GraspGaitMujoco-v0", object="ellipse", mu=0.7, *,
+    sim_config=None, pose_noise=(0.0, 0.0), config=None, render_mode=None, **fields)``
 
-    - ``object, mu, hand, turn_deg, n`` and every keyword of ``GraspGait-v0`` (reward
-      weights, ``max_backward_deg``, map window, ``render_mode``): as there. ``mu`` is
-      the planning friction (the controller's friction cone check uses it); the
-      contacts' true friction is ``sim_config.finger_mu``.
+    - ``object, mu, config, render_mode`` and the ``fields`` of
+      :class:`~graspgait_env.envs.config.GraspGaitConfig` (``hand``, ``turn_deg``,
+      ``n``, reward weights, ``max_backward_deg``, map window): as in ``GraspGait-v0``,
+      checked the same way. ``mu`` is the planning friction (the controller's friction
+      cone check uses it); the contacts' true friction is ``sim_config.finger_mu``.
     - ``sim_config``: :class:`~graspgait_env.sim.config.SimConfig`, a YAML path or None
       for ``configs/sim/default.yaml``.
     - ``pose_noise``: ``(max_offset_m, max_angle_deg)`` of the initial pose
@@ -155,35 +160,40 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     def __init__(
         self,
-        object: str | Shape = "ellipse",  # noqa: A002 - the user-facing name (docs/cli.md OBJECT)
+        object: str | os.PathLike | Shape = "ellipse",  # noqa: A002 - the user-facing name
         mu: float = 0.7,
-        hand: str | Hand | None = None,
-        turn_deg: float = 360.0,
-        n: int = 180,
         *,
-        sim_config: SimConfig | str | None = None,
+        sim_config: SimConfig | str | os.PathLike | None = None,
         pose_noise: tuple[float, float] | str = (0.0, 0.0),
-        **kwargs: Any,
+        config: GraspGaitConfig | None = None,
+        render_mode: str | None = None,
+        **fields: Any,
     ) -> None:
-        super().__init__(object, mu, hand, turn_deg, n, **kwargs)
+        super().__init__(object, mu, config=config, render_mode=render_mode, **fields)
+        fix = "give (max_offset_m, max_angle_deg), e.g. (0.006, 5.0), or 'thesis' for that"
         if isinstance(pose_noise, str):
             if pose_noise != "thesis":
-                raise ValueError(f"pose_noise={pose_noise!r}: give (max_offset_m, "
-                                 "max_angle_deg) or 'thesis' for (0.006, 5.0)")
+                raise GraspGaitInputError(f"pose_noise={pose_noise!r}: {fix}")
             pose_noise = (0.006, 5.0)
         try:
             off, ang = pose_noise
         except (TypeError, ValueError):
-            raise ValueError(f"pose_noise={pose_noise!r}: give (max_offset_m, max_angle_deg), "
-                             "e.g. (0.006, 5.0)") from None
-        self.pose_noise = (_finite("pose_noise[0]", off, nonneg=True),
-                           _finite("pose_noise[1]", ang, nonneg=True))
+            raise GraspGaitInputError(f"pose_noise={pose_noise!r}: {fix}") from None
+        self.pose_noise = (check_number("pose_noise[0]", off, 0.006, minimum=0.0,
+                                        why="metres"),
+                           check_number("pose_noise[1]", ang, 5.0, minimum=0.0,
+                                        why="degrees"))
+        if not (sim_config is None or isinstance(sim_config, (SimConfig, str, os.PathLike))):
+            raise GraspGaitInputError(
+                f"sim_config={sim_config!r}: give a SimConfig, a path to a sim YAML, or None "
+                "for configs/sim/default.yaml")
         self.sim_config = (sim_config if isinstance(sim_config, SimConfig)
                            else load_sim_config(sim_config))
         # the executor loads the object's physical fields from its file when it has one
         self._sim_object: str | Shape = object if isinstance(object, str) else self.model.shape
         self.executor: GaitExecutor | None = None
         self._est_k: int | None = None  # estimated angle on the grid (None: use commanded)
+        self._restricted = False
         self._replay: dict[str, Any] | None = None
 
     # ------------------------------------------------------------------ simulation
@@ -235,13 +245,12 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         self._restricted = False
         if self._est_k is None or self._est_k == self._k:
             return mask
-        dk = self._est_k - self._k
-        b = 2 * self._R
-        p = np.arange((self._A - b) // 2)  # workspace position of each regrasp target
-        inside = (p + dk >= 0) & (p + dk < self._W[self._h])
+        model, s, est_k = self.model, GaitState(self._k, self._c), self._est_k
         restricted = mask.copy()
-        restricted[b::2] &= inside
-        restricted[b + 1::2] &= inside
+        for a in np.flatnonzero(mask):
+            m = model.decode(s, int(a))
+            if m.kind == REGRASP and model.position(m.finger, m.contact, est_k) < 0:
+                restricted[a] = False  # the new contact is outside the workspace at est_k
         if not restricted.any():
             return mask
         self._restricted = bool((restricted != mask).any())
@@ -252,7 +261,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
               options: dict[str, Any] | None = None) -> tuple[NDArray[np.float32], dict]:
         """Draw a start grasp (``GraspGait-v0``), place the object with the pose
         perturbation and make the grasp on the simulated hand; returns ``(obs, info)``."""
-        given = options is not None and options.get("start") is not None
+        given = isinstance(options, Mapping) and options.get("start") is not None
         failures = []
         for attempt in range(1 if given else _START_TRIES):
             self._est_k = None
@@ -260,7 +269,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
             pert = (0.0, 0.0, 0.0)
             if self.pose_noise != (0.0, 0.0):
                 pert = random_pose_perturbation(self.np_random, *self.pose_noise)
-            contacts = self._contacts_deg(tuple(self._c))
+            contacts = self._contacts_deg(self._c)
             self.executor = self._make_executor()
             before = self._warning_counts()
             report = self.executor.reset(contacts, pose_perturbation=pert)
@@ -300,11 +309,9 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
         """Execute one move on the simulated hand; see the class docstring."""
-        if self.executor is None:
-            raise RuntimeError("step: call reset() first")
-        a = int(action)
-        if not 0 <= a < self._A or not self._mask[a]:  # out of range (raises) or illegal
-            out = super().step(action)
+        a = self._action_index(action)  # raises before reset() and for a bad action
+        if not self._mask[a]:  # illegal: a penalized no-op, no physics
+            out = super().step(a)
             out[4].update(self._sim_info(None, None))
             return out
         plan_step = self._plan_step(self.state, a)
@@ -323,22 +330,17 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
                      warning: str | None) -> tuple[NDArray[np.float32], float, bool, bool, dict]:
         """A drop, a failed contact or a MuJoCo warning: the episode ends; the commanded
         state stays where it was (the move did not complete)."""
-        terms = dict.fromkeys(REWARD_TERMS, 0.0)
         if plan_step["op"] == "rotate":
-            terms["rotation"] = -self.gamma
+            move = ROTATE
             self._rotations += 1
         else:
-            terms["regrasp"] = -self.beta
+            move = REGRASP
             self._regrasps += 1
-        if not self._terminal:
-            terms["dead_end"] = -self.dead_end_penalty
+        reward, terms = self._reward(self._k, self._k, move, not self._terminal, False)
         self._terminal = True
         self._restricted = False
         self._mask = np.zeros(self._A, dtype=bool)
         self._mask_view[...] = self._mask
-        t = terms
-        reward = (t["turn"] + t["regrasp"] + t["rotation"] + t["success"] + t["dead_end"]
-                  + t["illegal"])
         info = {
             "action_mask": self._mask,
             "reward_terms": terms,

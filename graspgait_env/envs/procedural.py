@@ -22,9 +22,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.objects import bundled_objects, load_object
 from graspgait_env.shapes import Ellipse, Polygon, Shape
 
@@ -93,8 +95,8 @@ def check_level(level: int) -> int:
     """Validate a difficulty level: an integer in ``0 .. len(LEVELS) - 1``."""
     if isinstance(level, bool) or not isinstance(level, (int, np.integer)) or not (
             0 <= level < len(LEVELS)):
-        raise ValueError(f"level={level!r}: must be an integer in 0..{len(LEVELS) - 1} "
-                         "(0 easiest)")
+        raise GraspGaitInputError(f"level={level!r}: must be an integer in "
+                                  f"0..{len(LEVELS) - 1} (0 easiest), e.g. 0")
     return int(level)
 
 
@@ -146,7 +148,7 @@ def procedural_object(seed: int, level: int = 0) -> Shape:
     """
     level = check_level(level)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed={seed!r}: must be a non-negative integer")
+        raise GraspGaitInputError(f"seed={seed!r}: must be a non-negative integer, e.g. 42")
     lv = LEVELS[level]
     name = f"proc-L{level}-{int(seed)}"
     rng = np.random.default_rng([int(seed), level])
@@ -177,16 +179,14 @@ def bundled_for_level(level: int) -> list[str]:
     return out
 
 
-def _check_range(name: str, r: tuple[int, int] | None) -> tuple[int, int] | None:
-    if r is None:
-        return None
-    try:
-        lo, hi = (int(v) for v in r)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}={r!r}: give a (lo, hi) pair of integers") from None
-    if not 0 <= lo < hi:
-        raise ValueError(f"{name}={r!r}: need 0 <= lo < hi (a half-open seed range)")
-    return lo, hi
+def _check_range(name: str, r: Any) -> tuple[int, int]:
+    fix = "give a half-open (lo, hi) range of integer seeds with 0 <= lo < hi, e.g. (0, 1000)"
+    pair = (not isinstance(r, (str, bytes)) and hasattr(r, "__len__") and len(r) == 2
+            and all(isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
+                    for v in r))
+    if not pair or not 0 <= r[0] < r[1]:
+        raise GraspGaitInputError(f"{name}={r!r}: {fix}")
+    return int(r[0]), int(r[1])
 
 
 class ObjectSampler:
@@ -207,20 +207,23 @@ class ObjectSampler:
 
     Raises
     ------
-    ValueError
-        A bad level, range or fraction, or an empty set of seeds to draw from.
+    GraspGaitInputError
+        A bad level, range or fraction, or an empty set of seeds to draw from (a
+        ``ValueError``; the message names the argument and the fix).
     """
 
     def __init__(self, level: int = 0, object_seeds: tuple[int, int] = SEED_RANGE,
                  exclude_seeds: tuple[int, int] | None = EVAL_SEEDS,
                  bundled_fraction: float = 0.2) -> None:
         self.level = check_level(level)
-        rng_ = _check_range("object_seeds", object_seeds)
-        assert rng_ is not None
-        self.object_seeds = rng_
-        self.exclude_seeds = _check_range("exclude_seeds", exclude_seeds)
-        if not (isinstance(bundled_fraction, (int, float)) and 0.0 <= bundled_fraction <= 1.0):
-            raise ValueError(f"bundled_fraction={bundled_fraction!r}: must be in [0, 1]")
+        self.object_seeds = _check_range("object_seeds", object_seeds)
+        self.exclude_seeds = (None if exclude_seeds is None
+                              else _check_range("exclude_seeds", exclude_seeds))
+        if (isinstance(bundled_fraction, (bool, np.bool_))
+                or not isinstance(bundled_fraction, (int, float, np.integer, np.floating))
+                or not 0.0 <= bundled_fraction <= 1.0):
+            raise GraspGaitInputError(f"bundled_fraction={bundled_fraction!r}: must be a number "
+                                      "in [0, 1] (the probability of a bundled object), e.g. 0.2")
         self.bundled_fraction = float(bundled_fraction)
         self.bundled = bundled_for_level(self.level)
         self._bundled_shapes = {name: load_object(name) for name in self.bundled}
@@ -229,10 +232,10 @@ class ObjectSampler:
         self._cut_lo, self._cut_hi = max(lo, min(xlo, hi)), max(lo, min(xhi, hi))
         self.n_seeds = (hi - lo) - (self._cut_hi - self._cut_lo)
         if self.n_seeds <= 0 and self.bundled_fraction < 1.0:
-            raise ValueError(f"object_seeds={self.object_seeds} minus exclude_seeds="
+            raise GraspGaitInputError(f"object_seeds={self.object_seeds} minus exclude_seeds="
                              f"{self.exclude_seeds} leaves no seed; widen object_seeds")
         if self.bundled_fraction > 0.0 and not self.bundled:
-            raise ValueError(f"level {self.level} admits no bundled object; set "
+            raise GraspGaitInputError(f"level {self.level} admits no bundled object; set "
                              "bundled_fraction=0")
 
     def seed_at(self, i: int) -> int:

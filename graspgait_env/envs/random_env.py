@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
-from graspgait_env.envs.map_env import GraspGaitEnv, _finite
+from graspgait_env.envs.config import (
+    GraspGaitConfig,
+    check_count,
+    check_mu,
+    check_number,
+    check_object,
+)
+from graspgait_env.envs.map_env import GraspGaitEnv
 from graspgait_env.envs.procedural import (
     EVAL_SEEDS,
     LEVELS,
@@ -12,11 +20,11 @@ from graspgait_env.envs.procedural import (
     ObjectSampler,
     procedural_object,
 )
-from graspgait_env.errors import ConfigError
+from graspgait_env.errors import ConfigError, GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.objects import load_object
 from graspgait_env.shapes import Circle, Shape
-from graspgait_env.workspace import Hand, load_hand
+from graspgait_env.workspace import load_hand
 
 __all__ = ["GraspGaitRandomEnv"]
 
@@ -55,20 +63,37 @@ class GraspGaitRandomEnv(GraspGaitEnv):
 
     ``reset(options=...)`` may fix the episode's object: ``{"object": name | path |
     Shape}`` or ``{"object_seed": int}`` (procedural at this level), and ``{"mu": float}``;
-    ``{"start": ...}`` as in ``GraspGait-v0``. The reset ``info`` names the object,
-    ``mu`` and ``object_seed`` (-1 for a bundled or given object).
+    ``{"start": ...}`` as in ``GraspGait-v0``; any other key raises ``ValueError``
+    naming it. The reset ``info`` names the object, ``mu`` and ``object_seed`` (-1 for a
+    bundled or given object).
 
     ## Arguments
 
     ``gymnasium.make("graspgait_env:GraspGaitRandom-v0", level=0, mu_range=None,
-    object_seeds=(0, 2**31 - 1), exclude_seeds=EVAL_SEEDS, bundled_fraction=0.2,
-    hand=None, turn_deg=360.0, n=180, **reward_and_window_kwargs, render_mode=None)``;
-    the keyword arguments after ``n`` are those of ``GraspGait-v0``.
+    object_seeds=(0, 2**31 - 1), exclude_seeds=EVAL_SEEDS, bundled_fraction=0.2, *,
+    config=None, render_mode=None, **fields)``; ``config``, ``render_mode`` and the
+    ``fields`` of :class:`~graspgait_env.envs.config.GraspGaitConfig` (``hand``,
+    ``turn_deg``, ``n``, the reward weights, ``max_backward_deg``, the map window) are
+    those of ``GraspGait-v0``. ``object`` and ``mu`` are not arguments: they are drawn at
+    every reset (pin them with ``reset(options=...)``). Every argument is checked at
+    construction (a ``ValueError`` naming it, the value and the fix).
+
+    - ``level``: an integer in ``0 .. 3``.
+    - ``mu_range``: ``(lo, hi)`` with ``0 < lo <= hi``; None: the level's range.
+    - ``object_seeds``, ``exclude_seeds``: half-open ranges ``(lo, hi)`` of integer
+      seeds, ``0 <= lo < hi`` (``exclude_seeds`` may be None).
+    - ``bundled_fraction``: the probability of a bundled object, in ``[0, 1]``.
 
     ## Version History
 
     - v0: initial version.
     """
+
+    _RESET_OPTIONS: ClassVar[tuple[str, ...]] = ("start", "object", "object_seed", "mu")
+    _ARG_HINTS: ClassVar[dict[str, str]] = {
+        name: ("the object and mu are drawn at every reset: pin them with "
+               "reset(options={'object': ..., 'mu': ...}), or use GraspGait-v0;")
+        for name in ("object", "mu")}
 
     def __init__(
         self,
@@ -77,72 +102,61 @@ class GraspGaitRandomEnv(GraspGaitEnv):
         object_seeds: tuple[int, int] = SEED_RANGE,
         exclude_seeds: tuple[int, int] | None = EVAL_SEEDS,
         bundled_fraction: float = 0.2,
-        hand: str | Hand | None = None,
-        turn_deg: float = 360.0,
-        n: int = 180,
         *,
-        alpha: float = 1.0,
-        beta: float = 0.01,
-        gamma: float = 0.01,
-        turn_scale_deg: float | None = None,
-        success_bonus: float = 1.0,
-        dead_end_penalty: float = 1.0,
-        illegal_penalty: float = 0.1,
-        max_backward_deg: float = 360.0,
-        map_window_deg: float = 360.0,
-        map_window_cells: int = 36,
+        config: GraspGaitConfig | None = None,
         render_mode: str | None = None,
+        **fields: Any,
     ) -> None:
-        self._configure(turn_deg=turn_deg, alpha=alpha, beta=beta, gamma=gamma,
-                        turn_scale_deg=turn_scale_deg, success_bonus=success_bonus,
-                        dead_end_penalty=dead_end_penalty, illegal_penalty=illegal_penalty,
-                        max_backward_deg=max_backward_deg, map_window_deg=map_window_deg,
-                        map_window_cells=map_window_cells, render_mode=render_mode)
+        self._configure(config, render_mode, fields)
         self.sampler = ObjectSampler(level, object_seeds, exclude_seeds, bundled_fraction)
         self.level = self.sampler.level
         if mu_range is not None:
-            try:
-                lo, hi = (_finite("mu_range", v, positive=True) for v in mu_range)
-            except TypeError:
-                raise ValueError(
-                    f"mu_range={mu_range!r}: give (lo, hi) with 0 < lo <= hi") from None
+            fix = "give (lo, hi) with 0 < lo <= hi, e.g. (0.3, 0.9), or None for the level's"
+            pair = (not isinstance(mu_range, (str, bytes, Mapping))
+                    and hasattr(mu_range, "__len__") and len(mu_range) == 2)
+            if not pair:
+                raise GraspGaitInputError(f"mu_range={mu_range!r}: {fix}")
+            lo, hi = (check_number(f"mu_range[{i}]", v, (0.3, 0.9)[i], minimum=0.0, strict=True)
+                      for i, v in enumerate(mu_range))
             if lo > hi:
-                raise ValueError(f"mu_range={mu_range!r}: give (lo, hi) with 0 < lo <= hi")
+                raise GraspGaitInputError(f"mu_range={mu_range!r}: {fix}")
             mu_range = (lo, hi)
         self.mu_range = mu_range
+        hand = self.config.hand
         try:
-            self.hand, _ = load_hand(hand, None)
+            self._hand, _ = load_hand(hand, None)
         except ConfigError as exc:
             if exc.field != "reach":
                 raise
-            raise ValueError(
+            raise GraspGaitInputError(
                 f"hand={hand!r}: a reach-limited hand's workspaces depend on the object, so the "
                 "action space would change between objects; give a hand with fixed "
                 "workspaces_deg (e.g. 'thesis')") from None
         self.object_seed = -1
         lo, hi = LEVELS[self.level].mu if mu_range is None else mu_range
         # the spaces depend only on the hand and n: any object sets them up
-        self._use_model(GaitModel(Circle(0.08, name="placeholder"), 0.5 * (lo + hi), self.hand,
-                                  n))
+        self._use_model(GaitModel(Circle(0.08, name="placeholder"), 0.5 * (lo + hi), self._hand,
+                                  self.config.n))
         self._make_spaces()
 
     def _model_for(self, shape: Shape, mu: float) -> GaitModel:
-        model = GaitModel(shape, mu, self.hand, self._n)
+        model = GaitModel(shape, mu, self._hand, self._n)
         self._check_model_fits(model)
         return model
 
-    def _on_reset(self, options: dict[str, Any]) -> GaitState | None:
+    def _on_reset(self, options: Mapping[str, Any]) -> GaitState | None:
         rng = self.np_random
         given = "object" in options or "object_seed" in options or "mu" in options
         if given:
             if "object" in options:
-                shape, seed = load_object(options["object"]), -1
+                shape, seed = load_object(check_object(options["object"],
+                                                       "options['object']")), -1
             elif "object_seed" in options:
-                seed = int(options["object_seed"])
+                seed = check_count("options['object_seed']", options["object_seed"], 0, 42)
                 shape = procedural_object(seed, self.level)
             else:
                 shape, seed = self.sampler.sample(rng)
-            mu = (float(options["mu"]) if "mu" in options
+            mu = (check_mu(options["mu"], "options['mu']") if "mu" in options
                   else self.sampler.sample_mu(rng, self.mu_range))
             self._use_model(self._model_for(shape, mu))
             self.object_seed = seed
@@ -163,7 +177,8 @@ class GraspGaitRandomEnv(GraspGaitEnv):
             f"grasp with a legal move (mu_range={self.mu_range}, seeds "
             f"{self.sampler.object_seeds}); raise mu_range or lower the level")
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Draw an object and ``mu``, then start an episode (see the class docstring)."""
         obs, info = super().reset(seed=seed, options=options)
         info["object_seed"] = self.object_seed

@@ -7,26 +7,32 @@ the extended grasp map (object frame, thesis fig. 3.3) with the finger pair boxe
 the present θ (thesis figs. 4.5, 6.1) and the gait so far as a path of grasps,
 unwrapped so that it climbs the extended map as the object turns.
 
-Nothing here touches pyplot except :func:`show_human`, which needs a window.
+:func:`render_frame` draws from plain data (the gait model, the gait so far, the turn
+asked for, the regrasps made), never from an env's attributes; :class:`GaitRenderer`,
+owned by the env, keeps what lives between frames (the human-mode window, the
+"cannot show" warning). Nothing here touches pyplot except :meth:`GaitRenderer.show`,
+which needs a window.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from graspgait_env.gait import GaitState
 from graspgait_env.plotting import plot_extended_map
 from graspgait_env.shapes import Polygon
 
 if TYPE_CHECKING:
-    from graspgait_env.envs.map_env import GraspGaitEnv
+    from graspgait_env.gait import GaitModel
 
-__all__ = ["render_frame", "can_show", "show_human", "FINGER_COLORS"]
+__all__ = ["render_frame", "can_show", "GaitRenderer", "FINGER_COLORS"]
 
 FINGER_COLORS = ("tab:red", "tab:green", "tab:blue")  # fingers 1, 2, 3
 _FIGSIZE = (11.0, 5.5)  # (inches) at _DPI: a 792 x 396 frame
@@ -46,10 +52,8 @@ def _rot(xy: NDArray[np.float64], theta_deg: float) -> NDArray[np.float64]:
     return xy @ np.array([[c, s], [-s, c]])
 
 
-def _draw_hand(ax, env: GraspGaitEnv) -> None:
-    model = env.model
+def _draw_hand(ax, model: GaitModel, st: GaitState, turn_deg: float, regrasps: int) -> None:
     shape = model.shape
-    st = env.state
     theta = st.k * model.step_deg
     xy = _rot(_outline(shape), theta)
     r = shape.r_max
@@ -81,23 +85,20 @@ def _draw_hand(ax, env: GraspGaitEnv) -> None:
     ax.set_xticks([])
     ax.set_yticks([])
     ax.set_title(f"{shape.name}, mu={model.mu:.3g}: theta={theta:g} deg of "
-                 f"{env.turn_deg:g}, {env._regrasps} regrasps", fontsize=9)
+                 f"{turn_deg:g}, {regrasps} regrasps", fontsize=9)
 
 
-def _draw_map(ax, env: GraspGaitEnv) -> None:
-    model = env.model
-    st = env.state
-    theta = st.k * model.step_deg
+def _draw_map(ax, model: GaitModel, trail: Sequence[tuple[int, tuple[int, ...]]]) -> None:
+    theta = trail[-1][0] * model.step_deg
     plot_extended_map(ax, model.grasp_map, model.hand, theta, box_labels=True,
                       title="extended grasp map, gait so far")
-    trail = getattr(env, "_trail", [(st.k, st.contacts)])
-    S, n, d = model.ws_start, model.n, model.step_deg
+    S, d = model.ws_start, model.step_deg
 
     def unwrapped(i: int, k: int, c: int) -> float:
         # x = s + p - k (grid steps): the path climbs the extended map as the object turns
-        return (int(S[i]) + (c + k - int(S[i])) % n - k) * d
+        return (int(S[i]) + model.position(i, c, k) - k) * d
 
-    k0, cs0 = trail[0]
+    cs0 = trail[0][1]
     axes = [i for i in range(3) if cs0[i] >= 0]  # finger on the horizontal, vertical axis
     pts = []
     prev = cs0
@@ -118,45 +119,100 @@ def _draw_map(ax, env: GraspGaitEnv) -> None:
     ax.yaxis.label.set_fontsize(8)
 
 
-def render_frame(env: GraspGaitEnv) -> NDArray[np.uint8]:
-    """Draw the present state of ``env``; returns an ``(H, W, 3)`` uint8 RGB array."""
+def render_frame(model: GaitModel, trail: Sequence[tuple[int, tuple[int, ...]]],
+                 turn_deg: float, regrasps: int) -> NDArray[np.uint8]:
+    """Draw a gait state; returns an ``(H, W, 3)`` uint8 RGB array.
+
+    Parameters
+    ----------
+    model
+        The gait model (object, friction, hand, grid).
+    trail
+        The gait so far as ``(k, contacts)`` pairs, the present state last (at least one).
+    turn_deg
+        The requested turn (degrees), for the title.
+    regrasps
+        Regrasps made so far, for the title.
+    """
+    k, cs = trail[-1]
     fig = Figure(figsize=_FIGSIZE, dpi=_DPI, layout="constrained")
     canvas = FigureCanvasAgg(fig)
     ax_h, ax_m = fig.subplots(1, 2, width_ratios=[1.0, 1.15])
-    _draw_hand(ax_h, env)
-    _draw_map(ax_m, env)
+    _draw_hand(ax_h, model, GaitState(k, tuple(cs)), turn_deg, regrasps)
+    _draw_map(ax_m, model, trail)
     canvas.draw()
     return np.asarray(canvas.buffer_rgba())[..., :3].copy()
 
 
-def can_show(env: GraspGaitEnv) -> bool:
-    """True when matplotlib can open a window; otherwise warn once (per env) and say no."""
+def can_show() -> bool:
+    """True when matplotlib's backend can open a window (an interactive backend)."""
     import matplotlib
     from matplotlib.backends import BackendFilter, backend_registry
 
     backend = matplotlib.get_backend().lower()
-    if backend not in backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE):
-        return True
-    if not env._human_warned:
-        env._human_warned = True
-        import gymnasium as gym
-
-        gym.logger.warn(
-            f"GraspGait render_mode='human': matplotlib backend {backend!r} cannot open a "
-            "window (no display), so nothing is shown; use render_mode='rgb_array'")
-    return False
+    return backend not in backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
 
 
-def show_human(env: GraspGaitEnv, frame: NDArray[np.uint8]) -> None:
-    """Show ``frame`` in a matplotlib window (pyplot), reusing it between calls."""
-    import matplotlib.pyplot as plt
+class GaitRenderer:
+    """What a GraspGait env keeps between frames: the human-mode window and the warning.
 
-    if env._fig is None or not plt.fignum_exists(env._fig.number):
-        env._fig = plt.figure("GraspGait", figsize=_FIGSIZE)
-        env._fig_img = env._fig.add_axes((0, 0, 1, 1))
-        env._fig_img.set_axis_off()
-        env._fig_im = env._fig_img.imshow(frame)
-    else:
-        env._fig_im.set_data(frame)
-    env._fig.canvas.draw_idle()
-    plt.pause(1.0 / env.metadata["render_fps"])
+    Parameters
+    ----------
+    render_fps
+        Frames per second of human mode (each :meth:`show` pauses ``1 / render_fps`` s).
+
+    Pickling and ``copy.deepcopy`` drop the window (a matplotlib figure does not
+    pickle); the next :meth:`show` opens a new one.
+    """
+
+    def __init__(self, render_fps: float) -> None:
+        self.render_fps = float(render_fps)
+        self.warned = False  # the "cannot show" warning is given once per renderer
+        self._fig: Any = None
+        self._im: Any = None
+
+    def show(self, model: GaitModel, trail: Sequence[tuple[int, tuple[int, ...]]],
+             turn_deg: float, regrasps: int) -> None:
+        """Draw the frame (as :func:`render_frame`) and show it in a matplotlib window,
+        reusing the window between calls; without a display, warn once and draw nothing."""
+        if not can_show():
+            if not self.warned:
+                self.warned = True
+                import gymnasium as gym
+                import matplotlib
+
+                gym.logger.warn(
+                    f"GraspGait render_mode='human': matplotlib backend "
+                    f"{matplotlib.get_backend().lower()!r} cannot open a window (no display), "
+                    "so nothing is shown; use render_mode='rgb_array'")
+            return
+        frame = render_frame(model, trail, turn_deg, regrasps)
+        import matplotlib.pyplot as plt
+
+        if self._fig is None or not plt.fignum_exists(self._fig.number):
+            self._fig = plt.figure("GraspGait", figsize=_FIGSIZE)
+            ax = self._fig.add_axes((0, 0, 1, 1))
+            ax.set_axis_off()
+            self._im = ax.imshow(frame)
+        else:
+            self._im.set_data(frame)
+        self._fig.canvas.draw_idle()
+        plt.pause(1.0 / self.render_fps)
+
+    def close(self) -> None:
+        """Close the window, if any (idempotent; never raises)."""
+        fig, self._fig, self._im = self._fig, None, None
+        if fig is not None:
+            try:
+                import matplotlib.pyplot as plt
+
+                plt.close(fig)
+            except Exception:  # noqa: BLE001 - closing must never fail
+                pass
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"render_fps": self.render_fps, "warned": self.warned}
+
+    def __setstate__(self, d: dict[str, Any]) -> None:
+        self.__init__(d["render_fps"])
+        self.warned = d["warned"]
