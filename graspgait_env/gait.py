@@ -40,7 +40,6 @@ With ``R = max_f W_f - 1`` (the longest rotation) and ``P = max_f W_f``:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -116,10 +115,13 @@ class GaitState(NamedTuple):
         return tuple(f for f, c in enumerate(self.contacts) if c >= 0)
 
 
-@dataclass(frozen=True)
-class Move:
+class Move(NamedTuple):
     """A decoded action: ``kind`` rotate (``delta`` grid steps, CCW positive) or regrasp
-    (``finger`` placed at ``contact``, ``lifted`` removed; fingers 0-based)."""
+    (``finger`` placed at ``contact``, ``lifted`` removed; fingers 0-based).
+
+    A NamedTuple, not a dataclass: the envs decode one per step, and a tuple is built in
+    a third of the time (measured: 0.25 vs 0.75 us).
+    """
 
     kind: str
     delta: int = 0
