@@ -33,6 +33,7 @@ import numpy as np
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import plan_from_states
 from graspgait_env.planners.result import PlannerResult
+from graspgait_env.planners.starts import require_start
 
 __all__ = ["optimal_gait", "PAIRS"]
 
@@ -57,9 +58,12 @@ class _Segments:
         for f, g in PAIRS:
             xf = self.x0[f] + np.arange(self.L[f])
             xg = self.x0[g] + np.arange(self.L[g])
-            kmin = np.maximum(np.maximum((s[f] - xf)[:, None], (s[g] - xg)[None, :]), k_lo)
-            kmax = np.minimum(np.minimum((s[f] + W[f] - 1 - xf)[:, None],
-                                         (s[g] + W[g] - 1 - xg)[None, :]), k_hi)
+            # the segment's angles: from k = 0, where the fingers sit at positions
+            # p = x - s (inside their workspaces or not), the object may turn ``ccw``
+            # steps one way and ``cw`` the other (thesis 5.2, GaitModel.rotation_room)
+            ccw, cw = model.rotation_room(f, (xf - s[f])[:, None], g, (xg - s[g])[None, :])
+            kmin = np.maximum(-cw, k_lo)
+            kmax = np.minimum(ccw, k_hi)
             stable = model.stable[np.ix_(xf % n, xg % n)]
             self.kmin.append(kmin)
             self.kmax.append(kmax)
@@ -73,8 +77,21 @@ class _Segments:
         return np.clip(lo, 0, self.L[h]), np.clip(hi, -1, self.L[h] - 1)
 
 
-def optimal_gait(model: GaitModel, start: GaitState, turn_deg: float = 360.0) -> PlannerResult:
+def optimal_gait(model: GaitModel, start: GaitState | None,
+                 turn_deg: float = 360.0) -> PlannerResult:
     """Minimum-regrasp gait from ``start`` turning the object ``turn_deg`` (sign = direction).
+
+    Parameters
+    ----------
+    model
+        The gait model.
+    start
+        Legal start state at ``k = 0``. ``None`` only answers when there is no legal
+        start at all (the no-gait verdict of
+        :func:`~graspgait_env.planners.starts.no_start_verdict`); otherwise it is refused
+        (:func:`~graspgait_env.planners.registry.run_planner` picks a start).
+    turn_deg
+        Requested turn (degrees; negative for clockwise).
 
     Returns
     -------
@@ -84,10 +101,17 @@ def optimal_gait(model: GaitModel, start: GaitState, turn_deg: float = 360.0) ->
         allows). Without: ``exhausted=True``, ``max_turn_deg`` the largest turn
         reachable in the search window, and the reason.
         ``nodes_opened`` counts segments expanded, ``nodes_created`` segments reached.
+
+    Raises
+    ------
+    GraspGaitInputError
+        ``start`` is not a legal grasp at ``k = 0``, or ``None`` while legal ones exist.
     """
     t0 = time.perf_counter()
-    if not model.is_legal_state(start) or start.k != 0:
-        raise ValueError(f"start {start}: must be a legal state at k = 0")
+    s0 = require_start(model, start, "optimal", t0)
+    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+        return s0
+    start = s0
     K = model.turn_steps(turn_deg)
     sign = 1 if K >= 0 else -1
     k_lo, k_hi = min(0, K) - model.n, max(0, K) + model.n
@@ -206,7 +230,8 @@ def _backtrack(model: GaitModel, seg: _Segments, level, goal, K: int, sign: int,
                 pi, pj = (xs[keep], int(cand[c])) if keep < t else (int(cand[c]), xs[keep])
                 found = (q, pi, pj, kreg)
                 break
-        assert found is not None, "exact planner: broken predecessor chain"
+        if found is None:  # a bug, never the user's input
+            raise RuntimeError("exact planner: broken predecessor chain")
         p, i, j, kreg = found
         chain.append((p, i, j))
         regrasp_k.append(kreg)

@@ -64,15 +64,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from graspgait_env.gait import GaitModel, workspace_grid
 from graspgait_env.workspace import Hand
-
-if TYPE_CHECKING:
-    from graspgait_env.gait import GaitModel
 
 __all__ = [
     "Check",
@@ -125,17 +123,12 @@ class WorkspaceGrid:
 
     @classmethod
     def from_hand(cls, hand: Hand | None = None, n: int = 180) -> WorkspaceGrid:
-        """The grid of a hand (default the thesis hand) at ``n`` grid angles, rounding the
-        workspace edges inwards as :class:`~graspgait_env.gait.GaitModel` does."""
+        """The grid of a hand (default the thesis hand) at ``n`` grid angles, rounded by
+        :func:`graspgait_env.gait.workspace_grid` as :class:`~graspgait_env.gait.GaitModel`
+        rounds it (thesis 4.1, 5.2)."""
         hand = hand or Hand.default()
-        step = 360.0 / n
-        starts, widths = [], []
-        for lo, hi in hand.workspaces_deg:
-            a0 = math.ceil(lo / step - 1e-9)
-            a1 = math.floor(hi / step + 1e-9)
-            starts.append(a0)
-            widths.append(a1 - a0 + 1)
-        return cls(n, tuple(starts), tuple(widths))
+        starts, widths = workspace_grid(hand.workspaces_deg, n)
+        return cls(n, tuple(int(a) for a in starts), tuple(int(w) for w in widths))
 
     @property
     def step_deg(self) -> float:
@@ -642,7 +635,7 @@ def box_placement_condition(box: BoxPrototype, geom: WorkspaceGrid) -> Check:
     overlap of at least ``w`` with an inner and with an outer box: a regrasp between the
     two is a step of at least ``w`` that must fit inside the box (condition 1 of 6.3.2).
     Mere touching is not enough — on synthetic box maps the exact planner finds a gait
-    exactly when both overlaps reach ``w`` (``tests/test_rule_based.py``).
+    exactly when both overlaps reach ``w`` (``tests/planners/test_prototypes.py``).
     """
     lo, hi = box.offset_range
     n, w = geom.n, geom.w_steps
@@ -670,7 +663,9 @@ def back_and_forth_conditions(stable: NDArray[np.bool_],
     The box is the squarest maximal box that is ``>= 2w × 2w`` and placed through an
     inner and an outer finger pair box (holding the start grasp in either reading when
     ``start`` is given); failing that, the squarest box (holding the start), whose failed
-    conditions are then reported. Returns ``(box, [size check, placement check])``.
+    conditions are then reported. Returns ``(box, [size check, placement check])``, or
+    ``(None, [one failed check])`` when no box holds the start or the map has no stable
+    cell at all.
     """
     S = np.asarray(stable, dtype=bool)
     n = S.shape[0]
@@ -697,8 +692,10 @@ def back_and_forth_conditions(stable: NDArray[np.bool_],
             placed &= hit
         if placed.any():
             box = _pick(boxes, placed, n, squarest=True)
-            assert box is not None
-            return box, [box_size_condition(box, w), box_placement_condition(box, g)]
+            if box is not None:  # always: ``placed`` selects at least one box
+                return box, [box_size_condition(box, w), box_placement_condition(box, g)]
     box = _pick(boxes, sel, n, squarest=True)
-    assert box is not None
+    if box is None:  # no stable cell at all (e.g. a regular pentagon at mu = 0.3)
+        return None, [Check(False, "no box: the grasp map has no stable grasp (thesis 6.2, "
+                                   "fig. 6.3 (b))")]
     return box, [box_size_condition(box, w), box_placement_condition(box, g)]

@@ -45,9 +45,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from graspgait_env.errors import GraspGaitInputError
-from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.gait import GaitModel, GaitState, workspace_grid
 from graspgait_env.plan import plan_from_states
 from graspgait_env.planners.result import PlannerResult
+from graspgait_env.planners.starts import require_start
 
 __all__ = [
     "breadth_first",
@@ -107,21 +108,22 @@ class _Graph:
 
     def __init__(self, model: GaitModel, start: GaitState, turn_deg: float,
                  theta_window_deg: tuple[float, float] | None) -> None:
-        if not model.is_legal_state(start) or start.k != 0:
-            raise ValueError(f"start {start}: must be a legal state at k = 0")
         self.model = model
         self.K = model.turn_steps(turn_deg)
         self.sign = 1 if self.K >= 0 else -1
         if theta_window_deg is None:
             self.k_lo, self.k_hi = min(0, self.K) - model.n, max(0, self.K) + model.n
         else:
-            lo, hi = theta_window_deg
-            self.k_lo = math.ceil(lo / model.step_deg - 1e-9)
-            self.k_hi = math.floor(hi / model.step_deg + 1e-9)
+            bad = GraspGaitInputError(
+                f"theta_window_deg={list(theta_window_deg)}: must contain 0 and the turn "
+                f"{self.K * model.step_deg:g} deg; widen it")
+            try:  # the grid angles inside the window, rounded as the workspaces are
+                (k0,), (width,) = workspace_grid([theta_window_deg], model.n)
+            except GraspGaitInputError:  # no grid angle inside
+                raise bad from None
+            self.k_lo, self.k_hi = int(k0), int(k0 + width - 1)
             if not self.k_lo <= min(0, self.K) <= max(0, self.K) <= self.k_hi:
-                raise GraspGaitInputError(
-                    f"theta_window_deg={list(theta_window_deg)}: must contain 0 and the turn "
-                    f"{self.K * model.step_deg:g} deg; widen it")
+                raise bad
         self.n = model.n
         self.R = model.R
         self.P = model.P
@@ -276,7 +278,7 @@ def _check_max_nodes(max_nodes: int) -> int:
     return int(max_nodes)
 
 
-def breadth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
+def breadth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0, *,
                   max_nodes: int = DEFAULT_MAX_NODES,
                   theta_window_deg: tuple[float, float] | None = None) -> PlannerResult:
     """Breadth-first search (thesis 5.3): the gait with the fewest moves.
@@ -290,7 +292,10 @@ def breadth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *
     model
         The gait model (object, friction, hand, grid).
     start
-        Legal start state at ``k = 0``.
+        Legal start state at ``k = 0``. ``None`` only answers when there is no legal
+        start at all (the no-gait verdict of
+        :func:`~graspgait_env.planners.starts.no_start_verdict`); otherwise it is refused
+        (:func:`~graspgait_env.planners.registry.run_planner` picks a start).
     turn_deg
         Requested turn (degrees; negative for clockwise).
     max_nodes
@@ -303,10 +308,19 @@ def breadth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *
     -------
     PlannerResult
         ``planner="breadth-first"``; see the module docstring for the counts.
+
+    Raises
+    ------
+    GraspGaitInputError
+        A ``start`` that is not a legal grasp at ``k = 0`` (or ``None`` while legal ones
+        exist), a bad ``max_nodes`` or a ``theta_window_deg`` that misses 0 or the turn.
     """
     t0 = time.perf_counter()
     max_nodes = _check_max_nodes(max_nodes)
-    G = _Graph(model, start, turn_deg, theta_window_deg)
+    s0 = require_start(model, start, "breadth-first", t0)
+    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+        return s0
+    G = _Graph(model, s0, turn_deg, theta_window_deg)
     opened = 0
     queue: deque[int] = deque([G.start_code])
     while G.goal < 0 and queue and opened < max_nodes:
@@ -314,10 +328,10 @@ def breadth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *
         opened += 1
         codes, _, _ = G.expand(code)
         queue.extend(codes.tolist())
-    return G.result("breadth-first", opened, t0, max_nodes, start, turn_deg, {})
+    return G.result("breadth-first", opened, t0, max_nodes, s0, turn_deg, {})
 
 
-def depth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
+def depth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0, *,
                 max_nodes: int = DEFAULT_MAX_NODES,
                 theta_window_deg: tuple[float, float] | None = None) -> PlannerResult:
     """Depth-first search with rotations first (thesis 5.4).
@@ -340,7 +354,10 @@ def depth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
     """
     t0 = time.perf_counter()
     max_nodes = _check_max_nodes(max_nodes)
-    G = _Graph(model, start, turn_deg, theta_window_deg)
+    s0 = require_start(model, start, "depth-first", t0)
+    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+        return s0
+    G = _Graph(model, s0, turn_deg, theta_window_deg)
     R = model.R
     forward_lt = G.sign > 0  # toward the goal: actions a < R are CCW
     opened = 0
@@ -359,10 +376,10 @@ def depth_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
         stack.extend(codes[is_reg][::-1].tolist())
         stack.extend(codes[back][::-1].tolist())
         stack.extend(codes[fwd].tolist())
-    return G.result("depth-first", opened, t0, max_nodes, start, turn_deg, {})
+    return G.result("depth-first", opened, t0, max_nodes, s0, turn_deg, {})
 
 
-def best_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
+def best_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0, *,
                max_nodes: int = DEFAULT_MAX_NODES, alpha: float = 1.0, beta: float = 1.0,
                gamma: float = 1.0, theta_window_deg: tuple[float, float] | None = None
                ) -> PlannerResult:
@@ -394,7 +411,10 @@ def best_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
     for name, w in (("alpha", alpha), ("beta", beta), ("gamma", gamma)):
         if not math.isfinite(w):
             raise GraspGaitInputError(f"{name}={w!r}: must be a finite number")
-    G = _Graph(model, start, turn_deg, theta_window_deg)
+    s0 = require_start(model, start, "best-first", t0)
+    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+        return s0
+    G = _Graph(model, s0, turn_deg, theta_window_deg)
     step_along = G.sign * model.step_deg  # degrees of progress per grid step
     k_scale = 3 * G.PP
     opened = 0
@@ -416,5 +436,5 @@ def best_first(model: GaitModel, start: GaitState, turn_deg: float = 360.0, *,
                                  strict=True):
             counter += 1
             push(heap, (key, counter, c, e, rr))
-    return G.result("best-first", opened, t0, max_nodes, start, turn_deg,
+    return G.result("best-first", opened, t0, max_nodes, s0, turn_deg,
                     {"alpha": alpha, "beta": beta, "gamma": gamma})

@@ -27,9 +27,9 @@ ENV = "graspgait_env.envs:GraspGait-v0"
 
 # (module, function): the planners with the shared signature; those not written yet skip
 PLANNERS = [("graspgait_env.planners.exact", "optimal_gait"),
-            ("graspgait_env.planners.rule_based", "forward_gait"),
-            ("graspgait_env.planners.rule_based", "back_and_forth_gait"),
-            ("graspgait_env.planners.rule_based", "modified_search"),
+            ("graspgait_env.planners.forward_gait", "forward_gait"),
+            ("graspgait_env.planners.back_and_forth_gait", "back_and_forth_gait"),
+            ("graspgait_env.planners.modified_search", "modified_search"),
             ("graspgait_env.planners.rule_based", "rule_based"),
             ("graspgait_env.planners.search", "best_first")]
 

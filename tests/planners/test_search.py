@@ -236,6 +236,17 @@ def test_bad_arguments():
         depth_first(model, GaitState(0, (-1, -1, 0)))
 
 
+def test_theta_window_is_rounded_as_the_workspaces_are():
+    """The window's grid angles come from gait.workspace_grid, the one grid rounding:
+    inwards, to 1e-9 of a step; a window holding no grid angle is refused by name."""
+    model = _model("circle", 36)  # 10-degree grid
+    s = _starts(model, 1)[0]
+    res = breadth_first(model, s, 90.0, theta_window_deg=(-5.0, 95.0 + 1e-12))
+    assert res.extra["theta_window_deg"] == [0.0, 90.0]
+    with pytest.raises(GraspGaitInputError, match="theta_window_deg"):
+        breadth_first(model, s, 0.0, theta_window_deg=(1.0, 9.0))
+
+
 # --------------------------------------------------------------------------- no gait
 
 
