@@ -291,10 +291,14 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     print(f"planner {res.planner}: nodes opened {res.nodes_opened}, created "
           f"{res.nodes_created}, wall time {res.wall_time_s * 1000:.1f} ms")
     if res.plan is None:
-        from graspgait_env.planners.rule_based import diagnose_no_gait
+        from graspgait_env.planners.diagnosis import diagnose_no_gait
 
-        why = res.reason or "no gait found"
-        raise NoGaitError(f"{why}; diagnosis: {diagnose_no_gait(model, start, args.turn)}")
+        # at most three lines (verdict, why, fix); the planner's own account and every
+        # detail of the diagnosis under --verbose
+        diagnosis = diagnose_no_gait(model, start, args.turn, verbose=args.verbose)
+        if args.verbose:
+            diagnosis = f"{res.planner}: {res.reason or 'no gait found'}\n{diagnosis}"
+        raise NoGaitError(f"no gait: {diagnosis}")
     v = validate_plan(res.plan, model.shape, model.hand, args.turn, model.max_radius)
     if v is not None:  # a planner bug, never the user's input
         raise RuntimeError(f"planner {args.planner} returned an invalid plan: "
@@ -356,6 +360,10 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                    help="keep contacts DEG degrees off polygon vertices (default 0, the "
                    "thesis's point contacts; 4 for plans run by `graspgait simulate`: a ball "
                    "tip rolls off corners)")
+    p.add_argument("--verbose", action="store_true",
+                   help="when no gait exists, print the planner's account and the whole "
+                   "diagnosis (grasp map, prototype conditions, each start tried) instead "
+                   "of three lines")
     p.add_argument("--json", metavar="FILE", help="write the plan JSON (docs/formats.md)")
     p.add_argument("--motion", metavar="FILE", help="write the thesis's motion_file (7.4.1)")
     p.add_argument("--png", metavar="FILE", help="draw the gait over the maps")

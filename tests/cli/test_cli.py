@@ -168,3 +168,15 @@ def test_plan_of_an_object_file_names_the_file(tmp_path):
     plan = Plan.load(out)
     assert plan.object == str(obj)
     assert validate_plan(plan) is None
+
+
+def test_no_gait_is_three_lines_and_verbose_tells_all(capsys):
+    argv = ["plan", "ellipse", "--mu", "0.7", "--planner", "rule", "--start", "0,180"]
+    assert main(argv) == 1
+    short = capsys.readouterr().err.strip().splitlines()
+    assert 1 <= len(short) <= 3 and short[0].startswith("graspgait: error: no gait")
+    assert main([*argv, "--verbose"]) == 1
+    full = capsys.readouterr().err.strip().splitlines()
+    assert len(full) > 3
+    assert any(ln.startswith("grasp map:") for ln in full)
+    assert any("rule-based" in ln for ln in full)  # the planner's own account
