@@ -298,7 +298,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         diagnosis = diagnose_no_gait(model, start, args.turn, verbose=args.verbose)
         if args.verbose:
             diagnosis = f"{res.planner}: {res.reason or 'no gait found'}\n{diagnosis}"
-        raise NoGaitError(f"no gait: {diagnosis}")
+        raise NoGaitError(f"no gait turns {model.shape.name} {args.turn:g} deg: {diagnosis}")
     v = validate_plan(res.plan, model.shape, model.hand, args.turn, model.max_radius)
     if v is not None:  # a planner bug, never the user's input
         raise RuntimeError(f"planner {args.planner} returned an invalid plan: "

@@ -174,7 +174,7 @@ def test_no_gait_is_three_lines_and_verbose_tells_all(capsys):
     argv = ["plan", "ellipse", "--mu", "0.7", "--planner", "rule", "--start", "0,180"]
     assert main(argv) == 1
     short = capsys.readouterr().err.strip().splitlines()
-    assert 1 <= len(short) <= 3 and short[0].startswith("graspgait: error: no gait")
+    assert 1 <= len(short) <= 3 and short[0].startswith("graspgait: error: no gait turns ellipse 360 deg")
     assert main([*argv, "--verbose"]) == 1
     full = capsys.readouterr().err.strip().splitlines()
     assert len(full) > 3
