@@ -66,7 +66,7 @@ from graspgait_env.planners.prototypes import (
     back_and_forth_conditions,
 )
 from graspgait_env.planners.result import PlannerResult
-from graspgait_env.planners.starts import check_start, no_start_verdict
+from graspgait_env.planners.starts import own_start_verdict
 from graspgait_env.planners.trace import (
     Stuck,
     Trace,
@@ -330,13 +330,9 @@ def back_and_forth_gait(model: GaitModel, start: GaitState | None = None,
         ``start`` is not a legal grasp at ``k = 0``.
     """
     t0 = time.perf_counter()
-    if start is None:
-        verdict = no_start_verdict(model, "rule-based", t0)
-        if verdict is not None:
-            verdict.extra["method"] = "back-and-forth"
-            return verdict
-    else:
-        check_start(model, start)
+    verdict = own_start_verdict(model, start, t0, "back-and-forth")
+    if verdict is not None:
+        return verdict
     g = WorkspaceGrid.from_model(model)
     box, checks = back_and_forth_conditions(model.stable, g,
                                             None if start is None else start.contacts)

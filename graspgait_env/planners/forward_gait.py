@@ -41,7 +41,7 @@ from graspgait_env.planners.prototypes import (
     inner_offset,
 )
 from graspgait_env.planners.result import PlannerResult
-from graspgait_env.planners.starts import check_start, no_start_verdict
+from graspgait_env.planners.starts import own_start_verdict
 from graspgait_env.planners.trace import (
     Stuck,
     Trace,
@@ -116,13 +116,9 @@ def forward_gait(model: GaitModel, start: GaitState | None = None,
         ``start`` is not a legal grasp at ``k = 0``.
     """
     t0 = time.perf_counter()
-    if start is None:
-        verdict = no_start_verdict(model, "rule-based", t0)
-        if verdict is not None:
-            verdict.extra["method"] = "forward"
-            return verdict
-    else:
-        check_start(model, start)
+    verdict = own_start_verdict(model, start, t0, "forward")
+    if verdict is not None:
+        return verdict
     g = WorkspaceGrid.from_model(model)
     sign = 1 if turn_deg >= 0 else -1
     band, checks = forward_conditions(model.stable, g, None if start is None else start.contacts)

@@ -20,7 +20,7 @@ from graspgait_env.planners.diagnosis import diagnose_no_gait
 from graspgait_env.planners.forward_gait import forward_gait
 from graspgait_env.planners.modified_search import DEFAULT_MAX_NODES, modified_search
 from graspgait_env.planners.result import PlannerResult
-from graspgait_env.planners.starts import check_start, no_start_verdict
+from graspgait_env.planners.starts import own_start_verdict
 from graspgait_env.planners.trace import add_nodes
 
 __all__ = ["rule_based", "diagnose_no_gait", "DEFAULT_MAX_NODES"]
@@ -60,12 +60,9 @@ def rule_based(model: GaitModel, start: GaitState | None = None, turn_deg: float
         ``start`` is not a legal grasp at ``k = 0``.
     """
     t0 = time.perf_counter()
-    if start is None:
-        verdict = no_start_verdict(model, "rule-based", t0)
-        if verdict is not None:
-            return verdict
-    else:
-        check_start(model, start)
+    verdict = own_start_verdict(model, start, t0)
+    if verdict is not None:
+        return verdict
     notes = []
     spent = 0
     for fn in (forward_gait, back_and_forth_gait):  # thesis 6.5: a prototype gait first

@@ -152,3 +152,25 @@ def require_start(model: GaitModel, start: GaitState | None, planner: str,
             "registry.default_start")
     check_start(model, start)
     return start
+
+
+def own_start_verdict(model: GaitModel, start: GaitState | None, t0: float,
+                      method: str | None = None) -> PlannerResult | None:
+    """The start rule of the planners that may choose their own start (the rule-based ones).
+
+    With ``start=None``: the no-gait verdict (:func:`no_start_verdict`, labelled
+    ``rule-based`` with ``extra["method"] = method``) when no legal start exists, else
+    ``None`` (the planner chooses). With a start: ``None`` after :func:`check_start`.
+
+    Raises
+    ------
+    GraspGaitInputError
+        ``start`` is not legal (:func:`check_start`).
+    """
+    if start is not None:
+        check_start(model, start)
+        return None
+    verdict = no_start_verdict(model, "rule-based", t0)
+    if verdict is not None and method is not None:
+        verdict.extra["method"] = method
+    return verdict
