@@ -174,9 +174,35 @@ def test_no_gait_is_three_lines_and_verbose_tells_all(capsys):
     argv = ["plan", "ellipse", "--mu", "0.7", "--planner", "rule", "--start", "0,180"]
     assert main(argv) == 1
     short = capsys.readouterr().err.strip().splitlines()
-    assert 1 <= len(short) <= 3 and short[0].startswith("graspgait: error: no gait turns ellipse 360 deg")
+    assert 1 <= len(short) <= 3
+    assert short[0].startswith("graspgait: error: no gait turns ellipse 360 deg")
     assert main([*argv, "--verbose"]) == 1
     full = capsys.readouterr().err.strip().splitlines()
     assert len(full) > 3
     assert any(ln.startswith("grasp map:") for ln in full)
     assert any("rule-based" in ln for ln in full)  # the planner's own account
+
+
+def test_bench_exit_codes(tmp_path, capsys):
+    out = tmp_path / "b.json"
+    argv = ["bench", "--objects", "circle", "--mus", "0.7", "--starts", "1", "--planners",
+            "rule,optimal"]
+    assert main([*argv, "--json", str(out)]) == 0
+    assert {r["planner"] for r in json.loads(out.read_text())["runs"]} == {"rule", "optimal"}
+    assert main([*argv, "--starts", "0"]) == 2
+
+
+def test_simulate_exit_codes(tmp_path, capsys):
+    """0 when the hand turns the object, 1 when it drops it (finger friction 0.05), 2 for
+    a plan file that is not there."""
+    from graspgait_env.sim.config import DEFAULT_SIM_CONFIG
+
+    plan = tmp_path / "circle.json"
+    assert main(["plan", "circle", "--mu", "0.7", "--planner", "optimal", "--turn", "60",
+                 "--json", str(plan)]) == 0
+    assert main(["simulate", str(plan), "--quiet"]) == 0
+    slippery = tmp_path / "slippery.yaml"
+    slippery.write_text(DEFAULT_SIM_CONFIG.read_text().replace("finger_mu: 1.0 ",
+                                                                "finger_mu: 0.05"))
+    assert main(["simulate", str(plan), "--quiet", "--config", str(slippery)]) == 1
+    assert main(["simulate", str(tmp_path / "none.json")]) == 2
