@@ -8,7 +8,8 @@ One module per thesis section, named in the thesis's words:
   necessary conditions for prototype gaits (6.2-6.3);
 - :mod:`~graspgait_env.planners.forward_gait`: the forward (staircase) gait (6.3.1);
 - :mod:`~graspgait_env.planners.back_and_forth_gait`: the back-and-forth (plus /
-  combined) gait (6.3.2);
+  combined) gait (6.3.2), with its entry into the box and, through
+  :mod:`~graspgait_env.planners.mirror`, its clockwise mirror;
 - :mod:`~graspgait_env.planners.modified_search`: the modified search, pruned by the
   prototype gaits' structure (6.4);
 - :mod:`~graspgait_env.planners.rule_based`: the rule-based method that combines them

@@ -1,5 +1,5 @@
 """The back-and-forth gait (thesis 6.3.2): the plus / combined gait of a box prototype,
-rules 1–11, counter-clockwise.
+rules 1–11, counter-clockwise and (mirrored) clockwise.
 
 When the grasp map holds a box at least ``2w × 2w`` that passes through both workspace
 box pairs (:func:`~graspgait_env.planners.prototypes.back_and_forth_conditions`), rules
@@ -40,10 +40,18 @@ Choices where the thesis is ambiguous (each tested in ``tests/planners``)
   first turned back (clockwise) by the deficit, as far as the workspaces allow; when a
   finger at the start of its workspace blocks the turn, the preparatory backward step
   on the other axis is taken, and the turn back goes on.
-  From some starts the rules still get stuck; the result then says where, and
-  :func:`~graspgait_env.planners.rule_based.rule_based` goes on to the modified search.
+- Entry (6.3.2: "there is no initial condition that would preclude a successful
+  gait"): from a start outside every box, a breadth-first search of at most
+  :data:`ENTRY_MAX_MOVES` moves reaches the box nearest in moves, and the rules run
+  from there (measured on the bench's starts at mu 0.7: the ellipse needs 1-3 moves
+  from 2 of 10 starts, the hexagon 1-2 from 5 of 10; from a sixth hexagon start no box
+  grasp lies within 4 moves and :func:`~graspgait_env.planners.rule_based.rule_based`
+  goes on to the modified search). A grasp from which the rules get stuck is skipped
+  for the next one; the result says where the last one got stuck.
   With ``start=None`` the rules start inside the box and, on synthetic box maps,
   succeed exactly when the box conditions hold (tested).
+- Clockwise turns: the counter-clockwise rules on the mirror image
+  (:mod:`~graspgait_env.planners.mirror`), every move checked again on the model.
 - Pattern: ``plus`` when the last half-turn visits at most the five grasp-map points
   of the + (fig. 6.10 (b)), ``combined`` when the gait uses backward steps and more
   points (fig. 6.10 (c)), ``staircase`` when no backward step was needed. A minimum box
@@ -54,18 +62,24 @@ Choices where the thesis is ambiguous (each tested in ``tests/planners``)
 from __future__ import annotations
 
 import time
-from typing import Any
+from collections.abc import Iterator
+from functools import lru_cache
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.planners.mirror import mirror_state, mirrored
 from graspgait_env.planners.prototypes import (
     BoxPrototype,
     WorkspaceGrid,
     back_and_forth_conditions,
+    box_prototypes,
 )
 from graspgait_env.planners.result import PlannerResult
+from graspgait_env.planners.search import _PAIRS, _Graph
 from graspgait_env.planners.starts import own_start_verdict
 from graspgait_env.planners.trace import (
     Stuck,
@@ -77,7 +91,9 @@ from graspgait_env.planners.trace import (
     gait_result,
 )
 
-__all__ = ["back_and_forth_gait"]
+__all__ = ["back_and_forth_gait", "ENTRY_MAX_MOVES"]
+
+ENTRY_MAX_MOVES = 4  # (moves) longest breadth-first entry into a box from a given start
 
 
 def _reach(model: GaitModel, h: int, lo: int, hi: int, k: int) -> NDArray[np.int64]:
@@ -302,62 +318,125 @@ def _box_starts(model: GaitModel, box: BoxPrototype) -> list[GaitState]:
     return out
 
 
-def back_and_forth_gait(model: GaitModel, start: GaitState | None = None,
-                        turn_deg: float = 360.0) -> PlannerResult:
-    """The back-and-forth gait of thesis 6.3.2 (rules 1–11) inside a box prototype.
+class _Found(NamedTuple):
+    """A counter-clockwise gait of rules 1–11: its trace, backward steps, the nodes opened
+    besides its moves (entry search, stuck tries) and the result's extras."""
 
-    The box is the squarest maximal stable box ``>= 2w × 2w`` placed through an inner and
-    an outer finger pair box (holding ``start`` when given). ``start=None`` tries the
-    box's grasps at θ = 0 (one per finger pair reading, nearest the box's lower-left
-    corner while ``>= w`` from its top and right edges) and keeps the first that turns
-    the object. Counter-clockwise turns only (a negative ``turn_deg`` is refused with a
-    reason).
+    trace: Trace
+    backward: int
+    opened: int
+    extra: dict[str, Any]
 
-    Returns
-    -------
-    PlannerResult
-        ``planner="rule-based"``, ``extra["method"] = "back-and-forth"``,
-        ``extra["box"]``, ``extra["conditions"]``, ``extra["rules"]`` (the rule behind
-        each move); ``pattern`` is ``plus``, ``combined`` or ``staircase`` (module
-        docstring). ``nodes_opened == path_length`` unless a start grasp tried first got
-        stuck (its moves are counted as opened nodes too). With ``start=None`` and no
-        stable grasp inside the workspaces at θ = 0: the no-gait verdict of
-        :func:`~graspgait_env.planners.starts.no_start_verdict`.
 
-    Raises
-    ------
-    GraspGaitInputError
-        ``start`` is not a legal grasp at ``k = 0``.
-    """
-    t0 = time.perf_counter()
-    verdict = own_start_verdict(model, start, t0, "back-and-forth")
-    if verdict is not None:
-        return verdict
+@lru_cache(maxsize=16)
+def _placed_boxes_cached(key: bytes, n: int, ws_start: tuple[int, ...],
+                         ws_width: tuple[int, ...]) -> tuple[BoxPrototype, ...]:
+    S = np.frombuffer(key, dtype=bool).reshape(n, n)
+    g = WorkspaceGrid(n, ws_start, ws_width)
+    return tuple(box_prototypes(S, 2 * g.w_steps, geom=g, placed=True))
+
+
+def _placed_boxes(model: GaitModel, g: WorkspaceGrid) -> tuple[BoxPrototype, ...]:
+    """Every maximal box meeting the conditions of 6.3.2 (``>= 2w × 2w``, through an inner
+    and an outer finger pair box), squarest first; cached per grasp map and hand."""
+    S = np.ascontiguousarray(np.asarray(model.stable, dtype=bool))
+    return _placed_boxes_cached(S.tobytes(), model.n, g.ws_start, g.ws_width)
+
+
+def _first_box(boxes: tuple[BoxPrototype, ...], a: NDArray[np.int64], b: NDArray[np.int64]
+               ) -> NDArray[np.int64]:
+    """Per grasp ``(a[i], b[i])`` (contacts): the index of the first box holding it in
+    either reading, ``len(boxes)`` when none does. Vectorized over boxes and grasps."""
+    n = boxes[0].n
+    x0 = np.array([bx.x_lo for bx in boxes])[:, None]
+    y0 = np.array([bx.y_lo for bx in boxes])[:, None]
+    wx = np.array([bx.width_steps for bx in boxes])[:, None]
+    wy = np.array([bx.height_steps for bx in boxes])[:, None]
+    inside = ((((a - x0) % n <= wx) & ((b - y0) % n <= wy))
+              | (((b - x0) % n <= wx) & ((a - y0) % n <= wy)))
+    return np.where(inside.any(axis=0), inside.argmax(axis=0), len(boxes))
+
+
+def _entry_candidates(model: GaitModel, boxes: tuple[BoxPrototype, ...], start: GaitState,
+                      max_moves: int, counter: list[int]
+                      ) -> Iterator[tuple[list[GaitState], BoxPrototype]]:
+    """Grasps inside a box, nearest the start first: a breadth-first search of at most
+    ``max_moves`` moves (any legal rotation or regrasp, each state once), level by level;
+    within a level by the first box holding the grasp (:func:`_placed_boxes` order,
+    squarest first), then in creation order. Yields the path from ``start`` and the box;
+    ``counter[0]`` counts the nodes opened."""
+    if not boxes:
+        return
+    f0, g0 = start.held()
+    first = int(_first_box(boxes, np.array([start.contacts[f0]]),
+                           np.array([start.contacts[g0]]))[0])
+    if first < len(boxes):  # already in a box: no search at all
+        yield [start], boxes[first]
+    if max_moves == 0:
+        return
+    # the search's window: as far as max_moves rotations reach either way
+    reach = max_moves * model.R * model.step_deg
+    G = _Graph(model, start, model.step_deg, (-reach, reach))
+    n, PP, P = model.n, G.PP, G.P
+    ws = np.asarray(model.ws_start, dtype=np.int64)
+    pairs = np.array(_PAIRS)
+    level = np.array([G.start_code], dtype=np.int64)
+    for _ in range(max_moves):
+        nxt = []
+        for code in level.tolist():
+            counter[0] += 1
+            codes, _, _ = G.expand(code)
+            nxt.append(codes)
+        level = np.concatenate(nxt)
+        if not level.size:
+            return
+        kk, rem = np.divmod(level, 3 * PP)
+        pair, rem = np.divmod(rem, PP)
+        pf, pg = np.divmod(rem, P)
+        k = kk + G.k_lo
+        f, g = pairs[pair, 0], pairs[pair, 1]
+        which = _first_box(boxes, (ws[f] + pf - k) % n, (ws[g] + pg - k) % n)
+        hit = np.flatnonzero(which < len(boxes))
+        for i in hit[np.argsort(which[hit], kind="stable")].tolist():
+            yield _path_to(G, int(level[i])), boxes[int(which[i])]
+
+
+def _path_to(G: _Graph, code: int) -> list[GaitState]:
+    """The states from the search's start to ``code`` (parent links)."""
+    out = [code]
+    while G.parent[out[-1]] != out[-1]:
+        out.append(int(G.parent[out[-1]]))
+    return [G.decode(c) for c in reversed(out)]
+
+
+def _ccw(model: GaitModel, start: GaitState | None, turn_deg: float, max_entry: int,
+         t0: float) -> _Found | PlannerResult:
+    """The counter-clockwise gait of rules 1–11 (see :func:`back_and_forth_gait`)."""
     g = WorkspaceGrid.from_model(model)
-    box, checks = back_and_forth_conditions(model.stable, g,
-                                            None if start is None else start.contacts)
+    box, checks = back_and_forth_conditions(model.stable, g)
     extra: dict[str, Any] = {"method": "back-and-forth",
                              "conditions": [c.reason for c in checks],
                              "box": None if box is None else box.describe()}
-    if turn_deg < 0:
-        return gait_failure("rule-based", "back-and-forth gait: only counter-clockwise turns "
-                            "are implemented (thesis 6.3.2 lists the CCW rules)", t0, extra)
     if box is None or not all(checks):
         return gait_failure("rule-based", "back-and-forth gait (thesis 6.3.2) conditions fail: "
                             + failed_reasons(checks), t0, extra)
-    starts = [start] if start is not None else _box_starts(model, box)
-    if not starts:
-        return gait_failure("rule-based", f"back-and-forth gait: no grasp at theta = 0 inside "
-                            f"the {box.describe()}", t0, extra)
     K = model.turn_steps(turn_deg)
-    why, best_k, spent = "", 0, 0
-    for s0 in starts:
-        reading = _box_reading(box, s0, model.n)
-        if reading is None:  # the box holds every start tried (conditions, _box_starts)
-            why = f"{model.describe_state(s0)} lies outside the {box.describe()}"
+    counter = [0]
+    if start is None:  # a grasp at theta = 0 inside the box, no entry needed
+        tries = ((([s0], box)) for s0 in _box_starts(model, box))
+    else:  # thesis 6.3.2: no initial condition precludes the gait; enter a box first
+        tries = _entry_candidates(model, _placed_boxes(model, g), start, max_entry, counter)
+    why, best_k, spent, tried = "", 0, 0, 0
+    for entry, bx in tries:
+        s0 = entry[-1]
+        reading = _box_reading(bx, s0, model.n)
+        if reading is None:  # every candidate lies in its box (_entry_candidates, _box_starts)
             continue
-        trace = Trace(model, [s0])
-        gait = _BoxGait(model, g, box, trace, *reading)
+        tried += 1
+        trace = Trace(model, [entry[0]])
+        for t in entry[1:]:
+            trace.push(t, "6.3.2 entry into the box")
+        gait = _BoxGait(model, g, bx, trace, *reading)
         try:
             gait.run(K)
         except Stuck as exc:
@@ -365,10 +444,93 @@ def back_and_forth_gait(model: GaitModel, start: GaitState | None = None,
             best_k = max(best_k, max(st.k for st in trace.states))
             spent += len(trace.states) - 1
             continue
-        res = gait_result("rule-based", model, trace, t0,
-                          gait_pattern(model, trace, gait.backward), extra)
-        if spent:  # moves of start grasps whose rules got stuck count as opened nodes
-            add_nodes(res, spent, spent)
-        return res
+        extra.update(box=bx.describe(), entry_moves=len(entry) - 1,
+                     entry_needed=len(entry) > 1)
+        return _Found(trace, gait.backward, spent + counter[0], extra)
+    if start is not None and not tried:
+        why = (f"no grasp within {max_entry} moves of {model.describe_state(start)} lies in a "
+               "box that meets the conditions")
     return gait_failure("rule-based", f"back-and-forth gait stuck: {why}", t0, extra,
-                        best_k * model.step_deg, (spent, spent))
+                        best_k * model.step_deg, (spent + counter[0], spent + counter[0]))
+
+
+def back_and_forth_gait(model: GaitModel, start: GaitState | None = None,
+                        turn_deg: float = 360.0,
+                        entry_max_moves: int = ENTRY_MAX_MOVES) -> PlannerResult:
+    """The back-and-forth gait of thesis 6.3.2 (rules 1–11) inside a box prototype.
+
+    The boxes are the maximal stable boxes ``>= 2w × 2w`` placed through an inner and an
+    outer finger pair box (:func:`~graspgait_env.planners.prototypes.box_prototypes`).
+
+    Thesis 6.3.2: "Using this method, if the conditions for the box size and placement
+    are met, there is no initial condition that would preclude a successful gait." So
+    reaching a box is part of the method: from a given ``start`` a breadth-first search
+    of at most ``entry_max_moves`` moves (any legal rotation or regrasp) finds the grasps
+    inside a box, the box reachable in the fewest moves first (ties: the squarest box,
+    then the first grasp found), and rules 1–11 run from there; a grasp from which the
+    rules get stuck is skipped for the next. ``start=None`` tries the squarest box's
+    grasps at θ = 0 (one per finger pair reading, nearest the box's lower-left corner
+    while ``>= w`` from its top and right edges) and keeps the first that turns the
+    object. A clockwise turn (``turn_deg < 0``) runs the same rules on the mirror image
+    (:mod:`~graspgait_env.planners.mirror`: "substituting right for left, top for
+    bottom, positive for negative").
+
+    Parameters
+    ----------
+    model
+        The gait model.
+    start
+        Start grasp at ``k = 0``, or ``None`` (see above).
+    turn_deg
+        Requested turn (degrees; negative: clockwise).
+    entry_max_moves
+        Longest entry into a box (moves) from a given ``start``.
+
+    Returns
+    -------
+    PlannerResult
+        ``planner="rule-based"``, ``extra["method"] = "back-and-forth"``,
+        ``extra["box"]`` (the box the rules ran in), ``extra["conditions"]``,
+        ``extra["rules"]`` (the rule behind each move: entry moves read "6.3.2 entry into
+        the box"), ``extra["entry_moves"]`` (moves before the rules: 0 when the start is
+        already in a box) and ``extra["entry_needed"]``; ``pattern`` is ``plus``,
+        ``combined`` or ``staircase`` (module docstring). ``nodes_opened`` is the path
+        length plus the entry search's nodes opened plus the moves of grasps whose rules
+        got stuck. With ``start=None`` and no stable grasp inside the workspaces at
+        θ = 0: the no-gait verdict of
+        :func:`~graspgait_env.planners.starts.no_start_verdict`.
+
+    Raises
+    ------
+    GraspGaitInputError
+        ``start`` is not a legal grasp at ``k = 0``, or ``entry_max_moves`` < 0.
+    """
+    t0 = time.perf_counter()
+    if isinstance(entry_max_moves, bool) or not isinstance(entry_max_moves, int) \
+            or entry_max_moves < 0:
+        raise GraspGaitInputError(f"entry_max_moves={entry_max_moves!r}: must be an integer "
+                                  ">= 0, e.g. 4")
+    verdict = own_start_verdict(model, start, t0, "back-and-forth")
+    if verdict is not None:
+        return verdict
+    if turn_deg >= 0:
+        found = _ccw(model, start, turn_deg, entry_max_moves, t0)
+        if isinstance(found, PlannerResult):
+            return found
+        trace = found.trace
+    else:  # thesis 6.3.2: the clockwise rules are the mirror image of the CCW ones
+        mm = mirrored(model)
+        found = _ccw(mm, None if start is None else mirror_state(start, model.n), -turn_deg,
+                     entry_max_moves, t0)
+        if isinstance(found, PlannerResult):
+            found.reason = f"clockwise (mirror image, thesis 6.3.2): {found.reason}"
+            found.max_turn_deg = -found.max_turn_deg
+            return found
+        states = [mirror_state(s, model.n) for s in found.trace.states]
+        trace = Trace(model, states[:1])
+        for t, rule in zip(states[1:], found.trace.rules, strict=True):
+            trace.push(t, rule)  # every mirrored move checked on the original model
+    res = gait_result("rule-based", model, trace, t0,
+                      gait_pattern(model, trace, found.backward), found.extra)
+    add_nodes(res, found.opened, found.opened)
+    return res

@@ -33,9 +33,9 @@ import numpy as np
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import plan_from_states
 from graspgait_env.planners.result import PlannerResult
-from graspgait_env.planners.starts import require_start
+from graspgait_env.planners.starts import check_start, no_start_verdict
 
-__all__ = ["optimal_gait", "PAIRS"]
+__all__ = ["optimal_gait", "PAIRS", "RegraspsToGo"]
 
 PAIRS = ((0, 1), (0, 2), (1, 2))
 
@@ -77,6 +77,40 @@ class _Segments:
         return np.clip(lo, 0, self.L[h]), np.clip(hi, -1, self.L[h] - 1)
 
 
+def _expand(seg: _Segments, frontier: list[np.ndarray], level: list[np.ndarray],
+            lvl: int) -> tuple[list[np.ndarray], int, int]:
+    """One breadth-first level: every segment one regrasp from ``frontier`` not yet
+    reached gets ``level = lvl`` (written in place) and makes the next frontier.
+
+    Returns ``(next frontier, segments expanded, segments reached)``.
+    """
+    nxt = [np.zeros(v.shape, dtype=bool) for v in seg.valid]
+    opened = created = 0
+    for p, (f, g) in enumerate(PAIRS):
+        fr = frontier[p]
+        if not fr.any():
+            continue
+        opened += int(fr.sum())
+        h = 3 - f - g
+        I, J = np.nonzero(fr)
+        lo, hi = seg.h_interval(h, seg.kmin[p][I, J], seg.kmax[p][I, J])
+        for keep, key in ((f, I), (g, J)):
+            q = _pair_index(keep, h)
+            Lh = seg.L[h]
+            D = np.zeros((seg.L[keep], Lh + 1), dtype=np.int32)
+            ok = lo <= hi
+            np.add.at(D, (key[ok], lo[ok]), 1)
+            np.add.at(D, (key[ok], hi[ok] + 1), -1)
+            cover = np.cumsum(D[:, :Lh], axis=1) > 0
+            if keep > h:  # pair q is (h, keep): rows are h
+                cover = cover.T
+            new = cover & seg.valid[q] & (level[q] < 0)
+            level[q][new] = lvl
+            nxt[q] |= new
+            created += int(new.sum())
+    return nxt, opened, created
+
+
 def optimal_gait(model: GaitModel, start: GaitState | None,
                  turn_deg: float = 360.0) -> PlannerResult:
     """Minimum-regrasp gait from ``start`` turning the object ``turn_deg`` (sign = direction).
@@ -86,10 +120,12 @@ def optimal_gait(model: GaitModel, start: GaitState | None,
     model
         The gait model.
     start
-        Legal start state at ``k = 0``. ``None`` only answers when there is no legal
-        start at all (the no-gait verdict of
-        :func:`~graspgait_env.planners.starts.no_start_verdict`); otherwise it is refused
-        (:func:`~graspgait_env.planners.registry.run_planner` picks a start).
+        Legal start state at ``k = 0``: the optimum from it. ``None``: the optimum for
+        the object — the fewest regrasps over every legal start grasp at θ = 0 (every
+        one is seeded at cost 0, so the breadth-first levels are the minimum over all
+        starts); the plan starts from the start it chose (``extra["start"]``). With no
+        legal start at all: the no-gait verdict of
+        :func:`~graspgait_env.planners.starts.no_start_verdict`.
     turn_deg
         Requested turn (degrees; negative for clockwise).
 
@@ -101,30 +137,42 @@ def optimal_gait(model: GaitModel, start: GaitState | None,
         allows). Without: ``exhausted=True``, ``max_turn_deg`` the largest turn
         reachable in the search window, and the reason.
         ``nodes_opened`` counts segments expanded, ``nodes_created`` segments reached.
+        ``extra["start"]`` describes the start of the plan, ``extra["start_chosen"]`` is
+        True when the planner chose it (``start=None``) and ``extra["starts_seeded"]``
+        counts the start grasps searched from.
 
     Raises
     ------
     GraspGaitInputError
-        ``start`` is not a legal grasp at ``k = 0``, or ``None`` while legal ones exist.
+        ``start`` is not a legal grasp at ``k = 0``.
     """
     t0 = time.perf_counter()
-    s0 = require_start(model, start, "optimal", t0)
-    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
-        return s0
-    start = s0
+    if start is None:
+        verdict = no_start_verdict(model, "optimal", t0)
+        if verdict is not None:  # no stable grasp at theta = 0: no gait
+            return verdict
+    else:
+        check_start(model, start)
     K = model.turn_steps(turn_deg)
     sign = 1 if K >= 0 else -1
     k_lo, k_hi = min(0, K) - model.n, max(0, K) + model.n
     seg = _Segments(model, k_lo, k_hi)
     level = [np.full(v.shape, -1, dtype=np.int32) for v in seg.valid]
-    f0, g0 = start.held()
-    pi0 = _pair_index(f0, g0)
-    # unwrapped contact at k = 0: x = s + p
-    i0 = model.ws_start[f0] + model.position(f0, start.contacts[f0], 0) - seg.x0[f0]
-    j0 = model.ws_start[g0] + model.position(g0, start.contacts[g0], 0) - seg.x0[g0]
-    level[pi0][i0, j0] = 0
     frontier = [np.zeros(v.shape, dtype=bool) for v in seg.valid]
-    frontier[pi0][i0, j0] = True
+    if start is None:  # every legal grasp at k = 0 (both contacts in their workspaces)
+        for p, (f, g) in enumerate(PAIRS):
+            # unwrapped contact at k = 0: x = s + p, array index x - x0
+            I = model.ws_start[f] + np.arange(model.ws_width[f]) - seg.x0[f]
+            J = model.ws_start[g] + np.arange(model.ws_width[g]) - seg.x0[g]
+            frontier[p][np.ix_(I, J)] = seg.valid[p][np.ix_(I, J)]
+    else:
+        f0, g0 = start.held()
+        i0 = model.ws_start[f0] + model.position(f0, start.contacts[f0], 0) - seg.x0[f0]
+        j0 = model.ws_start[g0] + model.position(g0, start.contacts[g0], 0) - seg.x0[g0]
+        frontier[_pair_index(f0, g0)][i0, j0] = True
+    seeded = int(sum(fr.sum() for fr in frontier))
+    for lv, fr in zip(level, frontier, strict=True):
+        lv[fr] = 0
     opened = created = 0
     best_turn = 0
     lvl = 0
@@ -143,43 +191,20 @@ def optimal_gait(model: GaitModel, start: GaitState | None,
                 goal = (p, int(i), int(j))
         if goal is not None:
             break
-        nxt = [np.zeros(v.shape, dtype=bool) for v in seg.valid]
-        any_front = False
-        for p, (f, g) in enumerate(PAIRS):
-            fr = frontier[p]
-            if not fr.any():
-                continue
-            any_front = True
-            opened += int(fr.sum())
-            h = 3 - f - g
-            I, J = np.nonzero(fr)
-            lo, hi = seg.h_interval(h, seg.kmin[p][I, J], seg.kmax[p][I, J])
-            for keep, key in ((f, I), (g, J)):
-                q = _pair_index(keep, h)
-                Lh = seg.L[h]
-                D = np.zeros((seg.L[keep], Lh + 1), dtype=np.int32)
-                ok = lo <= hi
-                np.add.at(D, (key[ok], lo[ok]), 1)
-                np.add.at(D, (key[ok], hi[ok] + 1), -1)
-                cover = np.cumsum(D[:, :Lh], axis=1) > 0
-                if keep > h:  # pair q is (h, keep): rows are h
-                    cover = cover.T
-                new = cover & seg.valid[q] & (level[q] < 0)
-                level[q][new] = lvl + 1
-                nxt[q] |= new
-                created += int(new.sum())
-        if not any_front:
-            break
-        frontier = nxt
+        frontier, o, c = _expand(seg, frontier, level, lvl + 1)
+        opened += o
+        created += c
         lvl += 1
         if not any(fr.any() for fr in frontier):
             break
 
     wall = time.perf_counter() - t0
+    where = (model.describe_state(start) if start is not None
+             else f"any of the {seeded} start grasps at theta = 0")
     if goal is None:
         return PlannerResult(
             "optimal", None,
-            reason=(f"no gait turns {turn_deg:g} deg from {model.describe_state(start)}: the "
+            reason=(f"no gait turns {turn_deg:g} deg from {where}: the "
                     f"reachable grasps turn the object at most {best_turn * model.step_deg:g} deg "
                     f"(exhaustive search of the window [{k_lo * model.step_deg:g}, "
                     f"{k_hi * model.step_deg:g}] deg)"),
@@ -187,18 +212,24 @@ def optimal_gait(model: GaitModel, start: GaitState | None,
             max_turn_deg=sign * best_turn * model.step_deg, wall_time_s=wall, exhausted=True)
     states = _backtrack(model, seg, level, goal, K, sign, start)
     plan = plan_from_states(model, states, merge_rotations=True)
+    extra = {"start": model.describe_state(states[0]), "start_chosen": start is None,
+             "starts_seeded": seeded}
     res = PlannerResult(
         "optimal", plan, nodes_opened=opened, nodes_created=created,
         path_length=len(plan.steps) - 1, regrasps=plan.regrasps, rotation_deg=plan.rotation_deg,
-        max_turn_deg=sign * best_turn * model.step_deg, wall_time_s=time.perf_counter() - t0)
+        max_turn_deg=sign * best_turn * model.step_deg, wall_time_s=time.perf_counter() - t0,
+        extra=extra)
     plan.stats = {"planner": "optimal", "nodes_opened": opened, "regrasps": plan.regrasps,
                   "rotation_deg": plan.rotation_deg}
+    if start is None:  # the plan says which start the planner chose
+        plan.stats["start_chosen"] = True
     return res
 
 
 def _backtrack(model: GaitModel, seg: _Segments, level, goal, K: int, sign: int,
-               start: GaitState) -> list[GaitState]:
-    """States from start to goal: regrasp at the segment angle farthest along the turn."""
+               start: GaitState | None) -> list[GaitState]:
+    """States from start to goal: regrasp at the segment angle farthest along the turn
+    (``start=None``: from the level-0 segment the chain leads back to, at ``k = 0``)."""
     s, W, n = model.ws_start, model.ws_width, model.n
     chain = [goal]  # (pair, i, j) from goal back to start
     p, i, j = goal
@@ -247,7 +278,7 @@ def _backtrack(model: GaitModel, seg: _Segments, level, goal, K: int, sign: int,
         cs[g] = int((seg.x0[g] + b) % n)
         return GaitState(int(k), tuple(cs))
 
-    states = [start]
+    states = [start if start is not None else state(chain[0], 0)]
     for node_next, kreg in zip(chain[1:], regrasp_k, strict=True):
         cur = states[-1]
         if kreg != cur.k:
@@ -256,3 +287,75 @@ def _backtrack(model: GaitModel, seg: _Segments, level, goal, K: int, sign: int,
     if states[-1].k != K:
         states.append(GaitState(K, states[-1].contacts))
     return states
+
+
+class RegraspsToGo:
+    """The fewest regrasps from every state to the requested turn: one table per model.
+
+    The exact planner's breadth-first search run backwards, from every segment that
+    reaches the turn (level 0) outwards. A regrasp can be undone (the same two grasps
+    share an object angle, thesis 4.2), so the regrasp graph over segments is undirected
+    and the level of a segment is its fewest regrasps *to* the goal. Rotations stay inside
+    a segment (thesis 5.2), so every state of a segment has the same count: calling the
+    table on a start state gives what :func:`optimal_gait` reports from it.
+
+    Search window (a choice, tested): object angles from ``max_backward_deg`` against
+    the turn to the turn itself, the angles an episode of the GraspGait envs can visit
+    before it ends (``optimal_gait`` also searches one more turn back; no bundled object
+    needs it).
+
+    Parameters
+    ----------
+    model
+        The gait model.
+    turn_deg
+        Requested turn (degrees; negative: clockwise).
+    max_backward_deg
+        How far against the turn the window reaches (degrees, > 0).
+
+    Examples
+    --------
+    >>> from graspgait_env.gait import GaitModel
+    >>> model = GaitModel("ellipse", 0.7)
+    >>> to_go = RegraspsToGo(model, 360.0, 360.0)
+    >>> start = model.start_state({1: 50.0, 3: 270.0})
+    >>> to_go(start) == optimal_gait(model, start, 360.0).regrasps
+    True
+    """
+
+    def __init__(self, model: GaitModel, turn_deg: float = 360.0,
+                 max_backward_deg: float = 360.0) -> None:
+        K = model.turn_steps(turn_deg)
+        B = abs(model.turn_steps(max_backward_deg))
+        sign = 1 if K >= 0 else -1
+        k_lo, k_hi = (-B, K) if sign > 0 else (K, B)
+        self.model, self.turn_steps = model, K
+        self._seg = seg = _Segments(model, k_lo, k_hi)
+        level = [np.full(v.shape, -1, dtype=np.int32) for v in seg.valid]
+        frontier = [v & ((km >= K) if sign > 0 else (kn <= K))
+                    for v, km, kn in zip(seg.valid, seg.kmax, seg.kmin, strict=True)]
+        for lv, fr in zip(level, frontier, strict=True):
+            lv[fr] = 0
+        lvl = 0
+        while any(fr.any() for fr in frontier):
+            lvl += 1
+            frontier, _, _ = _expand(seg, frontier, level, lvl)
+        self.levels = level
+        """Per finger pair (``PAIRS`` order), the count of every extended-map point
+        ``(x_f, x_g)`` (array index ``x - x0``); -1: no gait from it in the window."""
+
+    def __call__(self, state: GaitState) -> int:
+        """Fewest regrasps from ``state`` to the turn; -1 when no gait exists from it
+        (or ``state`` lies outside the window)."""
+        seg, model = self._seg, self.model
+        f, g = state.held()
+        k = int(state.k)
+        if not seg.k_lo <= k <= seg.k_hi:
+            return -1
+        # unwrapped contact x = s + p - k (see the module docstring)
+        i = model.ws_start[f] + model.position(f, state.contacts[f], k) - k - seg.x0[f]
+        j = model.ws_start[g] + model.position(g, state.contacts[g], k) - k - seg.x0[g]
+        lv = self.levels[_pair_index(f, g)]
+        if not (0 <= i < lv.shape[0] and 0 <= j < lv.shape[1]):
+            return -1
+        return int(lv[i, j])

@@ -2,7 +2,8 @@
 
 Each planner is ``planner(model, start, turn_deg) -> PlannerResult``; the rule-based ones
 (``forward``, ``back-and-forth``, ``rule``) choose their own start when given
-``start=None``, and :func:`run_planner` picks :func:`default_start` for the others.
+``start=None``, ``optimal`` then answers the fewest regrasps over every legal start, and
+:func:`run_planner` picks :func:`default_start` for the others.
 
 No gait is an answer, not an error: every planner returns a
 :class:`~graspgait_env.planners.result.PlannerResult` with ``plan=None`` and a
@@ -28,8 +29,10 @@ Planner = Callable[..., PlannerResult]
 # name -> "module:function" (imported on first use); one module per thesis section
 PLANNERS: dict[str, str] = {
     "bfs": "graspgait_env.planners.search:breadth_first",  # thesis 5.3
-    "dfs": "graspgait_env.planners.search:depth_first",  # thesis 5.4
-    "best-first": "graspgait_env.planners.search:best_first",  # thesis 5.5
+    "dfs": "graspgait_env.planners.search:depth_first",  # thesis 5.4, with a visited set
+    "dfs-thesis": "graspgait_env.planners.search:depth_first_thesis",  # 5.4 as the thesis ran it
+    "best-first": "graspgait_env.planners.search:best_first",  # thesis 5.5, ties: oldest
+    "best-first-newest": "graspgait_env.planners.search:best_first_newest",  # ties: newest
     "forward": "graspgait_env.planners.forward_gait:forward_gait",  # thesis 6.3.1
     "back-and-forth": "graspgait_env.planners.back_and_forth_gait:back_and_forth_gait",  # 6.3.2
     "modified": "graspgait_env.planners.modified_search:modified_search",  # thesis 6.4
@@ -38,8 +41,9 @@ PLANNERS: dict[str, str] = {
     "optimal": "graspgait_env.planners.exact:optimal_gait",
 }
 
-# planners that choose their own start when given none
-CHOOSE_OWN_START = frozenset({"forward", "back-and-forth", "rule"})
+# planners that choose their own start when given none (optimal: the object's optimum
+# over every legal start grasp at theta = 0)
+CHOOSE_OWN_START = frozenset({"forward", "back-and-forth", "rule", "optimal"})
 
 
 def get_planner(name: str) -> Planner:
@@ -88,7 +92,8 @@ def run_planner(name: str, model: GaitModel, start: GaitState | None,
         The gait model.
     start
         Start grasp at ``k = 0``, or ``None``: the rule-based planners (``forward``,
-        ``back-and-forth``, ``rule``) choose their own, the others get
+        ``back-and-forth``, ``rule``) choose their own, ``optimal`` returns the fewest
+        regrasps over every legal start (and says which it chose), the others get
         :func:`default_start`.
     turn_deg
         Requested turn (degrees, counter-clockwise positive).

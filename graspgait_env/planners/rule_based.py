@@ -3,8 +3,10 @@
 The thesis's second approach to generating gaits: the rule-based gait when the
 sufficient conditions of a prototype hold — the forward gait
 (:mod:`~graspgait_env.planners.forward_gait`, 6.3.1) first, then the back-and-forth
-gait (:mod:`~graspgait_env.planners.back_and_forth_gait`, 6.3.2) — else the modified
-search based on them (:mod:`~graspgait_env.planners.modified_search`, 6.4).
+gait (:mod:`~graspgait_env.planners.back_and_forth_gait`, 6.3.2, which first enters a
+box from a start outside one: "there is no initial condition that would preclude a
+successful gait") — else the modified search based on them
+(:mod:`~graspgait_env.planners.modified_search`, 6.4).
 
 :func:`diagnose_no_gait` (:mod:`~graspgait_env.planners.diagnosis`) is re-exported here
 for callers that import it from this module.
@@ -48,9 +50,12 @@ def rule_based(model: GaitModel, start: GaitState | None = None, turn_deg: float
     -------
     PlannerResult
         ``planner="rule-based"``; ``extra["method"]`` says which of ``forward``,
-        ``back-and-forth``, ``modified-search`` produced the plan, and
-        ``extra["prototypes"]`` why the earlier ones did not. Moves made by a rule gait
-        that then got stuck count as nodes opened. With ``start=None`` and no stable
+        ``back-and-forth``, ``modified-search`` produced the plan,
+        ``extra["prototypes"]`` why the earlier ones did not, ``extra["entry_moves"]``
+        how many moves the back-and-forth gait needed to enter its box (0 for the
+        other methods, which start from the start grasp) and ``extra["entry_needed"]``
+        whether it needed any. Moves made by a rule gait that then got stuck, and the
+        nodes of the entry search, count as nodes opened. With ``start=None`` and no stable
         grasp inside the workspaces at θ = 0: the no-gait verdict of
         :func:`~graspgait_env.planners.starts.no_start_verdict`.
 
@@ -69,6 +74,8 @@ def rule_based(model: GaitModel, start: GaitState | None = None, turn_deg: float
         r = fn(model, start, turn_deg)
         if r.success:
             r.extra["prototypes"] = notes
+            r.extra.setdefault("entry_moves", 0)
+            r.extra.setdefault("entry_needed", False)
             add_nodes(r, spent, spent)
             r.wall_time_s = time.perf_counter() - t0
             return r
@@ -78,6 +85,7 @@ def rule_based(model: GaitModel, start: GaitState | None = None, turn_deg: float
     r.planner = "rule-based"
     add_nodes(r, spent, spent)
     r.extra["prototypes"] = notes
+    r.extra.update(entry_moves=0, entry_needed=False)
     r.wall_time_s = time.perf_counter() - t0
     if r.plan is not None:
         r.plan.stats["planner"] = "rule-based"

@@ -53,12 +53,16 @@ from graspgait_env.planners.starts import require_start
 __all__ = [
     "breadth_first",
     "depth_first",
+    "depth_first_thesis",
     "best_first",
+    "best_first_newest",
+    "TIE_BREAKS",
     "best_first_metric",
     "DEFAULT_MAX_NODES",
 ]
 
 DEFAULT_MAX_NODES = 200_000  # (nodes opened) default cap for every search here
+TIE_BREAKS = ("oldest", "newest")  # best-first: which of equal-M open nodes goes first
 
 _PAIRS = ((0, 1), (0, 2), (1, 2))
 _PAIR_INDEX = {p: i for i, p in enumerate(_PAIRS)}
@@ -194,15 +198,11 @@ class _Graph:
                 coef[pi, sel] = 1 if h < keep else P
         self.act_off, self.act_cf, self.act_cg = off, cf, cg
 
-    def expand(self, code: int
-               ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
-        """Open node ``code``: its *new* children's codes, actions and is-regrasp flags.
-
-        The legal actions come from :meth:`GaitModel.action_mask` (one call); they are
-        decoded as :meth:`GaitModel.apply` does (:meth:`_action_tables`), in action
-        order; children outside the window or already created are dropped, the rest are
-        marked created with ``code`` as parent. The goal test is made here (``self.goal``).
-        """
+    def children(self, code: int
+                 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """Every legal child of ``code`` inside the window, created or not: codes, actions
+        and object angles ``k``, in action order (one :meth:`GaitModel.action_mask` call,
+        decoded as :meth:`GaitModel.apply` does, :meth:`_action_tables`)."""
         s = self.decode(code)
         acts = np.flatnonzero(self.model.action_mask(s))
         kk, rem = divmod(code, 3 * self.PP)
@@ -215,6 +215,18 @@ class _Graph:
             acts, kc = acts[inside], kc[inside]
         codes = (kk * 3 * self.PP + self.act_off[pair, acts] + pf * self.act_cf[pair, acts]
                  + pg * self.act_cg[pair, acts])
+        return codes, acts, kc
+
+    def expand(self, code: int
+               ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
+        """Open node ``code``: its *new* children's codes, actions and is-regrasp flags.
+
+        The legal actions come from :meth:`GaitModel.action_mask` (one call); they are
+        decoded as :meth:`GaitModel.apply` does (:meth:`_action_tables`), in action
+        order; children outside the window or already created are dropped, the rest are
+        marked created with ``code`` as parent. The goal test is made here (``self.goal``).
+        """
+        codes, acts, kc = self.children(code)
         new = self.parent[codes] < 0
         codes, acts, kc = codes[new], acts[new], kc[new]
         is_reg = self.act_is_reg[acts]
@@ -271,6 +283,19 @@ class _Graph:
                              wall_time_s=time.perf_counter() - t0, extra=extra)
 
 
+def _begin(model: GaitModel, start: GaitState | None, turn_deg: float, max_nodes: int,
+           theta_window_deg: tuple[float, float] | None, planner: str
+           ) -> tuple[float, int, GaitState | PlannerResult, _Graph | None]:
+    """The common start of every search here: ``(t0, max_nodes, start, graph)``, the graph
+    ``None`` (and ``start`` the no-gait verdict) when no legal start exists."""
+    t0 = time.perf_counter()
+    max_nodes = _check_max_nodes(max_nodes)
+    s0 = require_start(model, start, planner, t0)
+    if isinstance(s0, PlannerResult):
+        return t0, max_nodes, s0, None
+    return t0, max_nodes, s0, _Graph(model, s0, turn_deg, theta_window_deg)
+
+
 def _check_max_nodes(max_nodes: int) -> int:
     if isinstance(max_nodes, bool) or not isinstance(max_nodes, (int, np.integer)) \
             or max_nodes < 0:
@@ -315,12 +340,10 @@ def breadth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 3
         A ``start`` that is not a legal grasp at ``k = 0`` (or ``None`` while legal ones
         exist), a bad ``max_nodes`` or a ``theta_window_deg`` that misses 0 or the turn.
     """
-    t0 = time.perf_counter()
-    max_nodes = _check_max_nodes(max_nodes)
-    s0 = require_start(model, start, "breadth-first", t0)
-    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+    t0, max_nodes, s0, G = _begin(model, start, turn_deg, max_nodes, theta_window_deg,
+                                  "breadth-first")
+    if G is None:  # no stable grasp at theta = 0: no gait
         return s0
-    G = _Graph(model, s0, turn_deg, theta_window_deg)
     opened = 0
     queue: deque[int] = deque([G.start_code])
     while G.goal < 0 and queue and opened < max_nodes:
@@ -352,12 +375,10 @@ def depth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360
 
     Parameters and returns as :func:`breadth_first` (``planner="depth-first"``).
     """
-    t0 = time.perf_counter()
-    max_nodes = _check_max_nodes(max_nodes)
-    s0 = require_start(model, start, "depth-first", t0)
-    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+    t0, max_nodes, s0, G = _begin(model, start, turn_deg, max_nodes, theta_window_deg,
+                                  "depth-first")
+    if G is None:  # no stable grasp at theta = 0: no gait
         return s0
-    G = _Graph(model, s0, turn_deg, theta_window_deg)
     R = model.R
     forward_lt = G.sign > 0  # toward the goal: actions a < R are CCW
     opened = 0
@@ -379,42 +400,147 @@ def depth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360
     return G.result("depth-first", opened, t0, max_nodes, s0, turn_deg, {})
 
 
+def depth_first_thesis(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0, *,
+                       max_nodes: int = DEFAULT_MAX_NODES,
+                       theta_window_deg: tuple[float, float] | None = None) -> PlannerResult:
+    """Depth-first search in the thesis's form (thesis 5.4): a tree search, no visited set.
+
+    Thesis 5.4: "A depth first search explores only one possible motion from a given
+    grasp until either the goal is met or a dead end is reached. If a dead end is
+    reached, the search continues from a possible motion from the closest previous node.
+    ... the nodes which involved rotation were put at the head of the queue, in front of
+    the nodes involving regrasps." The thesis introduces "considering only the first path
+    found leading to a given node" only in 5.5, as the cure for this search's redundancy,
+    so here a state is created again on every path that reaches it — unlike
+    :func:`depth_first`, which keeps a visited set.
+
+    Choices where the thesis is silent (each tested):
+
+    - Rotations go toward the goal only (thesis 5.2 enumerates rotations "just greater
+      than zero to an upper limit" at the right or upper edge of the finger pair box),
+      the largest first, then the regrasps in action order.
+    - A state already on the current path is not entered again (without this a regrasp
+      and its reverse would make the search infinitely deep); it still counts as created.
+    - The node cap ``max_nodes`` bounds the search (nodes opened); the thesis's run on a
+      pentagon expanded over 2,000 nodes, created over 2,000,000 and found a path of
+      over 300.
+
+    Counting: ``nodes_opened`` = nodes expanded; ``nodes_created`` = every child generated
+    (repeats included), the start included. The goal test is made at creation, as in
+    every search here. An emptied stack proves that no gait with rotations toward the
+    goal only exists in the window (``exhausted=True``; the other searches here also
+    turn back).
+
+    Parameters and returns as :func:`breadth_first` (``planner="depth-first-thesis"``).
+    """
+    t0, max_nodes, s0, G = _begin(model, start, turn_deg, max_nodes, theta_window_deg,
+                                  "depth-first-thesis")
+    if G is None:  # no stable grasp at theta = 0: no gait
+        return s0
+    R, sign, K = model.R, G.sign, G.K
+    opened = 0
+    created = 1
+    best = 0
+    path: list[int] = []  # codes from the start to the node being explored
+    on_path: set[int] = set()
+    frames: list[list[int]] = []  # per path node: its children not yet tried, last first
+    goal = G.start_code if G.goal >= 0 else -1
+
+    def open_node(code: int) -> int:
+        """Expand ``code``: push its frame; the goal child if one is created, else -1."""
+        nonlocal opened, created, best
+        opened += 1
+        path.append(code)
+        on_path.add(code)
+        codes, acts, kc = G.children(code)
+        created += int(codes.size)
+        is_reg = G.act_is_reg[acts]
+        fwd = ~is_reg & ((acts < R) if sign > 0 else (acts >= R))
+        along = kc * sign
+        if fwd.any():
+            best = max(best, int(along[fwd].max()))
+            hit = fwd & (along >= sign * K)
+            if hit.any():  # the goal child nearest the goal angle: the plan ends at K
+                return int(codes[np.flatnonzero(hit)[np.argmin(along[hit])]])
+        rot = codes[fwd][np.argsort(along[fwd], kind="stable")]  # smallest first ...
+        order = np.concatenate((codes[is_reg][::-1], rot))  # ... so the largest pops first
+        frames.append(order.tolist())
+        return -1
+
+    if goal < 0:
+        goal = open_node(G.start_code)
+    while goal < 0 and frames and opened < max_nodes:
+        todo = frames[-1]
+        if not todo:  # dead end: back to the closest previous node
+            frames.pop()
+            on_path.discard(path.pop())
+            continue
+        child = todo.pop()
+        if child in on_path:
+            continue
+        goal = open_node(child)
+    G.created = created
+    G.best = best
+    if goal >= 0 and goal != G.start_code:
+        # the path found (the open nodes, then the goal), as parent links for _Graph.path()
+        chain = path + [goal]
+        for a, b in zip(chain[:-1], chain[1:], strict=True):
+            G.parent[b] = a
+    G.goal = goal
+    return G.result("depth-first-thesis", opened, t0, max_nodes, s0, turn_deg,
+                    {"visited_set": False})
+
+
 def best_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0, *,
                max_nodes: int = DEFAULT_MAX_NODES, alpha: float = 1.0, beta: float = 1.0,
-               gamma: float = 1.0, theta_window_deg: tuple[float, float] | None = None
-               ) -> PlannerResult:
+               gamma: float = 1.0, theta_window_deg: tuple[float, float] | None = None,
+               tie_break: str = "oldest") -> PlannerResult:
     """Best-first search with the thesis's metric and first-path-only pruning (thesis 5.5).
 
     Each created node carries its partial path's value :func:`best_first_metric`
     ``M = alpha * theta - beta * eta - gamma * r`` (``theta`` in degrees along the
     requested turn, ``eta`` regrasps and ``r`` rotations on the path); the open node with
-    the highest ``M`` is opened next, ties going to the node created *first* (a counter
-    in the heap key: deterministic; children are created in action order). Measured on
-    the thesis objects, first-created tie-breaking opens 2-10 times fewer nodes than
-    last-created. A state reached once is never created again (closed + open set by
-    state), so a node's ``M`` is that of the first path that reached it.
+    the highest ``M`` is opened next. Many open nodes share the same ``M`` (every
+    regrasp of one grasp does), and the thesis does not say which of them it opened
+    first; ``tie_break`` chooses (a creation counter in the heap key: deterministic;
+    children are created in action order). A state reached once is never created again
+    (closed + open set by state), so a node's ``M`` is that of the first path that
+    reached it.
 
     Parameters
     ----------
     alpha, beta, gamma
         Metric weights (thesis: all 1).
+    tie_break
+        ``"oldest"`` (default): among equal ``M`` the node created first is opened first
+        (a queue); ``"newest"``: the node created last (a stack, as a search that pushes
+        children on the head of its queue would). The README's Table 1 shows both beside
+        the thesis's figures.
     Others
         As :func:`breadth_first`.
 
     Returns
     -------
     PlannerResult
-        ``planner="best-first"``, ``extra`` holding the weights.
+        ``planner="best-first"``, ``extra`` holding the weights and ``tie_break``.
+
+    Raises
+    ------
+    GraspGaitInputError
+        As :func:`breadth_first`, a non-finite weight, or a ``tie_break`` not in
+        :data:`TIE_BREAKS`.
     """
-    t0 = time.perf_counter()
-    max_nodes = _check_max_nodes(max_nodes)
     for name, w in (("alpha", alpha), ("beta", beta), ("gamma", gamma)):
         if not math.isfinite(w):
             raise GraspGaitInputError(f"{name}={w!r}: must be a finite number")
-    s0 = require_start(model, start, "best-first", t0)
-    if isinstance(s0, PlannerResult):  # no stable grasp at theta = 0: no gait
+    if tie_break not in TIE_BREAKS:
+        raise GraspGaitInputError(f"tie_break={tie_break!r}: unknown; use one of "
+                                  f"{', '.join(TIE_BREAKS)}")
+    tick = 1 if tie_break == "oldest" else -1  # the heap pops the smallest counter first
+    t0, max_nodes, s0, G = _begin(model, start, turn_deg, max_nodes, theta_window_deg,
+                                  "best-first")
+    if G is None:  # no stable grasp at theta = 0: no gait
         return s0
-    G = _Graph(model, s0, turn_deg, theta_window_deg)
     step_along = G.sign * model.step_deg  # degrees of progress per grid step
     k_scale = 3 * G.PP
     opened = 0
@@ -434,7 +560,21 @@ def best_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.
         m = best_first_metric(step_along * ks, etas, rs, alpha, beta, gamma)
         for key, c, e, rr in zip((-m).tolist(), codes.tolist(), etas.tolist(), rs.tolist(),
                                  strict=True):
-            counter += 1
+            counter += tick
             push(heap, (key, counter, c, e, rr))
     return G.result("best-first", opened, t0, max_nodes, s0, turn_deg,
-                    {"alpha": alpha, "beta": beta, "gamma": gamma})
+                    {"alpha": alpha, "beta": beta, "gamma": gamma, "tie_break": tie_break})
+
+
+def best_first_newest(model: GaitModel, start: GaitState | None, turn_deg: float = 360.0,
+                      **kwargs) -> PlannerResult:
+    """:func:`best_first` with ``tie_break="newest"`` (the planner ``best-first-newest``).
+
+    Keyword arguments as :func:`best_first` (``tie_break`` excepted). Returns its result
+    with ``planner="best-first-newest"``.
+    """
+    res = best_first(model, start, turn_deg, tie_break="newest", **kwargs)
+    res.planner = "best-first-newest"
+    if res.plan is not None:
+        res.plan.stats["planner"] = res.planner
+    return res

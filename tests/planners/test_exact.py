@@ -127,3 +127,81 @@ def test_exact_no_more_regrasps_than_searches_on_thesis_objects():
                 assert (r.plan is None) == (exact.plan is None), (name, r.planner)
                 if exact.plan is not None:
                     assert exact.regrasps <= r.regrasps
+
+
+# --------------------------------------------------------------------------- object optimum
+@st.composite
+def hard_polygons(draw):
+    """Star polygons (as above) made harder: stretched along x (eccentric, E up to 2.5)
+    and/or with a notch (one vertex pulled in to 30-60 % of its radius)."""
+    verts = draw(star_polygons())
+    if draw(st.booleans()):
+        verts = verts * np.array([draw(st.floats(1.3, 2.5)), 1.0])
+    if draw(st.booleans()) and len(verts) >= 5:
+        i = draw(st.integers(0, len(verts) - 1))
+        verts = verts.copy()
+        verts[i] *= draw(st.floats(0.3, 0.6))
+    return verts
+
+
+@settings(max_examples=20, deadline=None)
+@given(hard_polygons(), st.floats(0.2, 0.8), st.sampled_from([360.0, -360.0]))
+def test_optimum_without_start_is_the_minimum_over_every_start(verts, mu, turn):
+    """``optimal`` without a start == the brute-force minimum of the per-start optima
+    over every legal start at theta = 0, and <= the optimum from any start."""
+    model = GaitModel(Polygon(verts, "random"), mu, n=N)
+    starts = model.start_states()
+    best = optimal_gait(model, None, turn)
+    if not starts:
+        event("no start grasp")
+        assert best.plan is None and best.exhausted
+        return
+    per = [optimal_gait(model, s, turn) for s in starts]
+    found = [r.regrasps for r in per if r.plan is not None]
+    event("no gait" if not found else "gait")
+    if not found:
+        assert best.plan is None and best.exhausted
+        assert str(len(starts)) in best.reason
+        return
+    assert best.plan is not None
+    assert best.regrasps == min(found)
+    assert all(best.regrasps <= r for r in found)
+    assert validate_plan(best.plan, model.shape, model.hand, turn) is None
+    # the plan names the start it chose: a legal start whose own optimum is the same
+    chosen = [s for s in starts if model.describe_state(s) == best.extra["start"]]
+    assert len(chosen) == 1 and best.extra["start_chosen"]
+    assert best.extra["starts_seeded"] == len(starts)
+    assert optimal_gait(model, chosen[0], turn).regrasps == best.regrasps
+    assert best.plan.stats["start_chosen"] is True
+
+
+def test_optimum_from_a_given_start_is_that_starts():
+    model = GaitModel("pentagon", 0.7)
+    s = model.start_state({1: 50.0, 3: 270.0})
+    res = optimal_gait(model, s)
+    assert res.extra == {"start": model.describe_state(s), "start_chosen": False,
+                         "starts_seeded": 1}
+    assert "start_chosen" not in res.plan.stats
+    assert optimal_gait(model, None).regrasps <= res.regrasps
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", bundled_objects())
+def test_object_optimum_at_n_180_on_bundled_objects(name):
+    """n = 180: the optimum without a start equals the minimum over every legal start of
+    the backward table (RegraspsToGo, a separate search from the goal), and the exact
+    planner from 40 spread starts never needs fewer regrasps."""
+    from graspgait_env.planners.exact import RegraspsToGo
+    from graspgait_env.planners.starts import spread_starts
+
+    model = GaitModel(name, 0.7)
+    best = optimal_gait(model, None)
+    to_go = RegraspsToGo(model, 360.0, 360.0)
+    counts = [c for c in (to_go(s) for s in model.start_states()) if c >= 0]
+    if best.plan is None:
+        assert not counts
+        return
+    assert best.regrasps == min(counts)
+    for s in spread_starts(model, 40):
+        r = optimal_gait(model, s)
+        assert r.plan is None or r.regrasps >= best.regrasps

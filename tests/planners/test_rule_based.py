@@ -25,8 +25,8 @@ def test_rule_based_on_bundled_objects(models, name):
     check_plan(m, res)
     if res.extra["method"] in ("forward", "back-and-forth"):
         assert res.nodes_opened == res.path_length
-    else:
-        assert res.nodes_opened >= res.path_length
+    else:  # the modified search's nodes are grasps, rotations implicit (thesis 6.5)
+        assert res.nodes_opened >= res.regrasps
     start = replay(m, res)[0]
     assert res.regrasps >= optimal_gait(m, start, 360.0).regrasps
 

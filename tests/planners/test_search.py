@@ -299,3 +299,72 @@ def test_vectorized_expansion_matches_model_successors(name):
         want = [(a, t) for a, t in model.successors(s) if G.k_lo <= t.k <= G.k_hi]
         assert got == want
         assert is_reg.tolist() == [t.k == s.k for _, t in want]
+
+
+# --------------------------------------------------------------------------- tie-break
+def test_best_first_tie_break_oldest_and_newest():
+    """The two readings of the unstated tie-break (thesis 5.5) are both searches of the
+    same graph: both find a valid gait, they open different nodes, and the default is
+    "oldest" (ties to the node created first)."""
+    from graspgait_env.planners.registry import get_planner
+    from graspgait_env.planners.search import best_first_newest
+
+    model = _model("ellipse", 90)
+    s = _starts(model, 2)[1]
+    old, new = best_first(model, s), best_first(model, s, tie_break="newest")
+    _check_result(model, old, 360.0)
+    assert new.plan is not None and validate_plan(new.plan, model.shape, model.hand) is None
+    assert old.extra["tie_break"] == "oldest" and new.extra["tie_break"] == "newest"
+    assert (old.nodes_opened, old.plan.steps) != (new.nodes_opened, new.plan.steps)
+    assert best_first(model, s, tie_break="oldest").plan.steps == old.plan.steps
+    named = get_planner("best-first-newest")
+    assert named is best_first_newest
+    r = named(model, s)
+    assert r.planner == r.plan.stats["planner"] == "best-first-newest"
+    assert r.plan.steps == new.plan.steps and r.nodes_opened == new.nodes_opened
+    with pytest.raises(GraspGaitInputError, match="tie_break"):
+        best_first(model, s, tie_break="random")
+
+
+# --------------------------------------------------------------------------- DFS, thesis form
+def test_depth_first_thesis_has_no_visited_set():
+    """Thesis 5.4: no visited set, so states are created again on every path reaching
+    them (more nodes created than distinct states exist along the way); rotations toward
+    the goal, the largest first, and regrasps only where rotation is spent."""
+    from graspgait_env.planners.search import depth_first_thesis
+
+    model = _model("pentagon", 180)
+    s = model.start_state({1: 50.0, 3: 270.0})  # the thesis's pentagon example
+    res = depth_first_thesis(model, s)
+    _check_result_any(model, res)
+    assert res.planner == "depth-first-thesis" and res.extra["visited_set"] is False
+    assert res.plan.steps[1] == {"op": "rotate", "delta": 40.0}
+    assert all(st["op"] == "regrasp" or st["delta"] > 0 for st in res.plan.steps[1:])
+    ours = depth_first(model, s)
+    assert res.nodes_created > ours.nodes_created  # repeats are created again
+    capped = depth_first_thesis(model, s, max_nodes=50)
+    assert capped.plan is None and not capped.exhausted and capped.nodes_opened == 50
+    assert capped.reason.startswith("node limit")
+
+
+def test_depth_first_thesis_exhausts_where_no_gait_exists():
+    # thesis ellipse at mu = 0.8 on a 10-degree grid: this grasp turns 16 deg at most
+    from graspgait_env.planners.search import depth_first_thesis
+
+    model = _model("ellipse", 36, 0.8)
+    for s in model.start_states()[:20]:
+        exact = optimal_gait(model, s)
+        res = depth_first_thesis(model, s, max_nodes=10**6)
+        assert (res.plan is None) == (exact.plan is None)
+        if res.plan is None:
+            assert res.exhausted
+            assert abs(res.max_turn_deg) <= abs(exact.max_turn_deg)
+
+
+def _check_result_any(model: GaitModel, res) -> None:
+    """As _check_result, for a planner whose stats carry its own name."""
+    assert res.plan is not None, res.reason
+    assert validate_plan(res.plan, model.shape, model.hand, 360.0) is None
+    assert res.path_length == len(res.plan.steps) - 1
+    assert res.regrasps == res.plan.regrasps
+    assert 1 <= res.nodes_opened <= res.nodes_created
