@@ -45,6 +45,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from graspgait_env.contact_model import POINT_CONTACTS, ContactModel
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.grasp_map import GraspMap, check_n, grasp_map
 from graspgait_env.objects import load_object
@@ -149,6 +150,12 @@ class GaitModel:
     vertex_clearance_deg
         Keep contacts this many degrees away from polygon vertices (see
         :func:`graspgait_env.grasp_map`); 0 (default) is the thesis's point-contact model.
+    contact_model
+        What the fingertips are (:mod:`graspgait_env.contact_model`): the default
+        :data:`~graspgait_env.contact_model.POINT_CONTACTS` gives the thesis's maps;
+        :func:`~graspgait_env.contact_model.hand_contact_model` the maps of plans the
+        simulated hand can execute (friction margin for the rotation's load, contacts
+        clear of the vertices a rolling ball would reach). Plans record it.
 
     Attributes
     ----------
@@ -163,7 +170,8 @@ class GaitModel:
 
     def __init__(self, shape: Shape | str, mu: float, hand: Hand | str | None = None,
                  n: int = 180, max_radius: float | None = None,
-                 vertex_clearance_deg: float = 0.0) -> None:
+                 vertex_clearance_deg: float = 0.0,
+                 contact_model: ContactModel = POINT_CONTACTS) -> None:
         self.n = check_n(n)
         if self.n > MAX_PLAN_N:
             raise GraspGaitInputError(
@@ -179,8 +187,10 @@ class GaitModel:
         cap = max_radius if max_radius is not None else hand_cap
         self.max_radius = cap
         self.mu = float(mu)
+        self.contact_model = contact_model
         self.grasp_map: GraspMap = grasp_map(self.shape, mu, self.n, max_radius=cap,
-                                             vertex_clearance_deg=vertex_clearance_deg)
+                                             vertex_clearance_deg=vertex_clearance_deg,
+                                             contact_model=contact_model)
         self.stable: NDArray[np.bool_] = self.grasp_map.stable
         self.step_deg = 360.0 / self.n
         self.ws_start, self.ws_width = workspace_grid(self.hand.workspaces_deg, self.n)

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from graspgait_env.contact_model import POINT_CONTACTS, ContactModel, rolling_contacts_deg
 from graspgait_env.force_closure import check_mu, force_closure_wrench
 from graspgait_env.shapes import Shape
 
@@ -140,6 +141,33 @@ def _usable(shape: Shape, phi: NDArray[np.float64], max_radius: float | None,
     return usable
 
 
+def _nguyen(P: NDArray[np.float64], N: NDArray[np.float64], mu: float,
+            contact_model: ContactModel) -> NDArray[np.bool_]:
+    """Force closure of every pair of contacts at points ``P`` with inward normals ``N``."""
+    # thesis 3.2 via Nguyen: d_ij = p_j - p_i must lie inside both friction cones,
+    # d_ij . n_i > cos(atan mu) |d_ij| and -d_ij . n_j > cos(atan mu) |d_ij|.
+    # With M = N P^T (M_ij = n_i . p_j) and h_i = n_i . p_i, d_ij . n_i = M_ij - h_i
+    # and -d_ij . n_j = M_ji - h_j; |d_ij|^2 comes from the Gram matrix. Two small
+    # matrix products instead of an (n, n, 2) tensor: no division, no arccos.
+    cos_a = math.cos(math.atan(mu))
+    M = N @ P.T
+    h = np.diagonal(M)
+    G = P @ P.T
+    sq = np.diagonal(G)
+    lim = np.sqrt(np.maximum(sq[:, None] + sq[None, :] - 2.0 * G, 0.0))
+    if not contact_model.is_point:
+        # the hand's contacts (graspgait_env.contact_model): each cone narrowed by the
+        # margin that carries the rotation's load, atan(tau / (G d)) for chord d
+        half = math.atan(mu) - np.radians(contact_model.margin_deg(lim))
+        with np.errstate(invalid="ignore"):  # no cone left: never stable
+            lim = np.where(half > 0, np.cos(np.clip(half, 0.0, None)), np.inf) * lim
+    else:
+        lim *= cos_a
+    A = M - h[:, None]
+    # squeezing (both dot products positive) or pushing apart in a notch (both negative)
+    return ((A > lim) & (A.T > lim)) | ((A < -lim) & (A.T < -lim))
+
+
 def grasp_map(
     shape: Shape,
     mu: float,
@@ -148,6 +176,7 @@ def grasp_map(
     max_radius: float | None = None,
     method: str = "nguyen",
     vertex_clearance_deg: float = 0.0,
+    contact_model: ContactModel = POINT_CONTACTS,
 ) -> GraspMap:
     """Compute the grasp map of ``shape`` at friction ``mu`` on an ``n``-point grid.
 
@@ -170,6 +199,14 @@ def grasp_map(
         (default 0: only contacts exactly on a vertex). A physical ball tip rolls along
         the contour as the object turns and can roll off a corner the point-contact model
         of the thesis never sees; a clearance keeps planned grasps away from corners.
+    contact_model
+        What the fingertips are (:mod:`graspgait_env.contact_model`): the default
+        :data:`~graspgait_env.contact_model.POINT_CONTACTS` is the thesis's model, bit
+        for bit. A ball-tip model keeps each chord ``margin_deg(chord)`` inside both
+        cones (the load of a rotation), wherever the balls roll to while the object
+        turns the gait's way by up to its ``max_rotation_deg`` (checked at the half and
+        the whole), and leaves out contacts nearer a vertex than its
+        ``vertex_clearance_m``; ``method="nguyen"`` only.
 
     Returns
     -------
@@ -198,27 +235,29 @@ def grasp_map(
     P = shape.contour_point(phi)
     N = shape.inward_normal(phi)
     if method == "nguyen":
-        # thesis 3.2 via Nguyen: d_ij = p_j - p_i must lie inside both friction cones,
-        # d_ij . n_i > cos(atan mu) |d_ij| and -d_ij . n_j > cos(atan mu) |d_ij|.
-        # With M = N P^T (M_ij = n_i . p_j) and h_i = n_i . p_i, d_ij . n_i = M_ij - h_i
-        # and -d_ij . n_j = M_ji - h_j; |d_ij|^2 comes from the Gram matrix. Two small
-        # matrix products instead of an (n, n, 2) tensor: no division, no arccos.
-        cos_a = math.cos(math.atan(mu))
-        M = N @ P.T
-        h = np.diagonal(M)
-        G = P @ P.T
-        sq = np.diagonal(G)
-        lim = np.sqrt(np.maximum(sq[:, None] + sq[None, :] - 2.0 * G, 0.0))
-        lim *= cos_a
-        A = M - h[:, None]
-        # squeezing (both dot products positive) or pushing apart in a notch (both negative)
-        stable = ((A > lim) & (A.T > lim)) | ((A < -lim) & (A.T < -lim))
+        stable = _nguyen(P, N, mu, contact_model)
+        if not contact_model.is_point and contact_model.max_rotation_deg != 0:
+            # the balls roll while the object turns the gait's way (contact_model): the
+            # grasp must hold wherever its contacts roll to in up to the largest rotation
+            rho, top = contact_model.tip_radius_m, contact_model.max_rotation_deg
+            for turn in (top / 2, top):
+                phr = rolling_contacts_deg(shape, phi, turn, rho)
+                stable &= _nguyen(shape.contour_point(phr), shape.inward_normal(phr), mu,
+                                  contact_model)
     elif method == "wrench":
+        if not contact_model.is_point:
+            raise ValueError(f"method='wrench': draws point-contact maps only; use "
+                             f"method='nguyen' for contact_model={contact_model.name!r}")
         I, J = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
         stable = force_closure_wrench(P[I], N[I], P[J], N[J], mu)
     else:
         raise ValueError(f"method={method!r}: use 'nguyen' or 'wrench'")
     usable = _usable(shape, phi, max_radius, vertex_clearance_deg)
+    if contact_model.vertex_clearance_m > 0:
+        va = getattr(shape, "vertex_angles_deg", None)
+        if va is not None:  # a rolling ball must not reach a corner (contact_model)
+            dv = np.linalg.norm(P[:, None, :] - shape.contour_point(va)[None], axis=2)
+            usable &= dv.min(axis=1) >= contact_model.vertex_clearance_m
     stable &= usable[:, None] & usable[None, :]
     np.fill_diagonal(stable, False)
     return _make(stable, phi, mu, shape.name, usable)

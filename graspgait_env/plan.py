@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from graspgait_env.atomic import write_text_atomic
+from graspgait_env.contact_model import POINT_CONTACTS, ContactModel
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.force_closure import force_closure_nguyen
 from graspgait_env.gait import GaitModel, GaitState
@@ -64,19 +65,36 @@ def _is_number(x: Any) -> bool:
 
 @dataclass
 class Plan:
-    """A gait plan (docs/formats.md). ``steps`` use finger numbers 1..3 as strings, degrees."""
+    """A gait plan (docs/formats.md). ``steps`` use finger numbers 1..3 as strings, degrees.
+
+    ``contact_model``: the contact model the planner assumed
+    (:meth:`ContactModel.to_json <graspgait_env.contact_model.ContactModel.to_json>`);
+    None (the field left out): the thesis's point contacts.
+    """
 
     object: str
     mu: float
     workspaces_deg: list[list[float]]
     steps: list[dict[str, Any]]
     stats: dict[str, Any] = field(default_factory=dict)
+    contact_model: dict[str, Any] | None = None
+
+    @property
+    def assumed_contact_model(self) -> ContactModel:
+        """The :class:`~graspgait_env.contact_model.ContactModel` the plan was made for
+        (:data:`~graspgait_env.contact_model.POINT_CONTACTS` when none is recorded)."""
+        if self.contact_model is None:
+            return POINT_CONTACTS
+        return ContactModel.from_json(self.contact_model)
 
     # ---------------------------------------------------------------- JSON
     def to_dict(self) -> dict[str, Any]:
         """The plan as the JSON-ready mapping of docs/formats.md."""
-        return {"object": self.object, "mu": self.mu, "workspaces_deg": self.workspaces_deg,
-                "steps": self.steps, "stats": self.stats}
+        d = {"object": self.object, "mu": self.mu, "workspaces_deg": self.workspaces_deg,
+             "steps": self.steps, "stats": self.stats}
+        if self.contact_model is not None:
+            d["contact_model"] = self.contact_model
+        return d
 
     def to_json(self) -> str:
         """JSON text (indented)."""
@@ -91,7 +109,7 @@ class Plan:
         """Read a plan mapping, checking every field's type before any use.
 
         Checked: the top-level keys (``object``, ``mu``, ``workspaces_deg``, ``steps``,
-        optional ``stats``; others are refused), ``mu`` a finite number > 0,
+        optional ``stats`` and ``contact_model``; others are refused), ``mu`` a finite number > 0,
         ``workspaces_deg`` a list of ``[lo, hi]`` pairs of finite degrees, and each
         step: ``op`` one of grasp/rotate/regrasp, the first a grasp and only the first;
         a rotate has a finite non-zero ``delta`` (degrees); a grasp or regrasp has
@@ -112,7 +130,7 @@ class Plan:
         if not isinstance(d, dict):
             raise GraspGaitInputError(f"{source}: a plan must be a JSON object "
                                       "(see docs/formats.md)")
-        known = ("object", "mu", "workspaces_deg", "steps", "stats")
+        known = ("object", "mu", "workspaces_deg", "steps", "stats", "contact_model")
         for key in d:
             if key not in known:
                 raise bad(str(key), d[key], f"unknown field; use only {', '.join(known)}")
@@ -164,8 +182,14 @@ class Plan:
         stats = d.get("stats", {})
         if not isinstance(stats, dict):
             raise bad("stats", stats, "must be an object (or be left out)")
+        cm = d.get("contact_model")
+        if cm is not None:
+            try:
+                cm = ContactModel.from_json(cm, "contact_model").to_json()
+            except GraspGaitInputError as exc:
+                raise GraspGaitInputError(f"{source}: {exc} (see docs/formats.md)") from None
         return cls(d["object"], float(mu), [[float(x) for x in w] for w in ws],
-                   [dict(st) for st in steps], dict(stats))
+                   [dict(st) for st in steps], dict(stats), cm)
 
     @classmethod
     def load(cls, path: str | Path) -> Plan:
@@ -376,5 +400,6 @@ def plan_from_states(model: GaitModel, states: list[GaitState],
                 steps.append({"op": "rotate", "delta": d})
         if b.contacts != a.contacts:
             steps.append({"op": "regrasp", "contacts": contacts(b)})
+    cm = getattr(model, "contact_model", POINT_CONTACTS)
     return Plan(model.shape.name, model.mu, [list(w) for w in model.hand.workspaces_deg],
-                steps, dict(stats or {}))
+                steps, dict(stats or {}), None if cm.is_point else cm.to_json())

@@ -19,7 +19,10 @@
 - :mod:`~graspgait_env.sim.executor`: :class:`GaitExecutor`, the task composing them,
   one move at a time;
 - :mod:`~graspgait_env.sim.simulate`: :func:`simulate_plan`, videos, step-rate benchmark,
-  the ``graspgait simulate`` command and its input checks.
+  the ``graspgait simulate`` command and its input checks;
+- :mod:`~graspgait_env.sim.view`: :class:`~graspgait_env.sim.view.HandView`, frames of
+  the hand from above with the workspaces, finger numbers and captions overlaid (the
+  ``GraspGaitMujoco-v0`` frames and the videos).
 
 Rendering is headless: ``MUJOCO_GL`` defaults to ``egl`` here, which takes effect only
 if MuJoCo has not been imported yet (the Makefile exports it too).

@@ -62,7 +62,7 @@ class SimConfig:
     """solref of the object-table contacts."""
     table_solimp: tuple[float, ...] = (0.95, 0.99, 0.001, 0.5, 2.0)
     """solimp of the object-table contacts."""
-    finger_mu: float | None = 1.0
+    finger_mu: float | None = None
     """True finger-object Coulomb friction; None: the plan's mu."""
     table_mu: float = 0.3
     """Object-table Coulomb friction."""
@@ -118,6 +118,8 @@ class SimConfig:
     """Tip acceleration limit of object rotations and recentering moves (m/s^2)."""
     approach_accel: float = 2.0
     """Acceleration limit on approach lines, where contact detection is armed (m/s^2)."""
+    trapezoidal_speed: bool = True
+    """Speed ramps at the accelerations above; False: constant speed (thesis 7.4.6)."""
     recenter_speed: float = 0.12
     """Speed of the recentering move that drags the held object back (m/s, thesis 7.5)."""
 
@@ -142,10 +144,14 @@ class SimConfig:
     """Servo force that signals contact (N): 1 oz."""
     contact_cycles: int = 3
     """Servo cycles above the threshold before contact is assumed."""
+    contact_along_approach: bool = True
+    """Test the servo force along the approach line; False: its magnitude (thesis 7.3)."""
 
     # localizer (thesis 7.4.5)
     localizer: bool = True
     """Use the object localizer (``graspgait_env.sim.localizer``) when three fingers touch."""
+    localize_during_transfer: bool = True
+    """Localize halfway through a regrasp's grip transfer; False: after it (7.4.2)."""
     initial_probe: bool = True
     """Touch the object with all three fingers and localize it before the first grasp."""
     probe_grip: float = 0.5
@@ -158,12 +164,14 @@ class SimConfig:
     """Probe contacts stay this far from a vertex of the expected polygon (deg)."""
     localizer_prior_weight: float = 0.01
     """Weight of the expected pose in the localizer's search (LocalizerConfig.prior_weight)."""
+    localizer_iterate: bool = True
+    """Iterate (grid and Gauss-Newton) to the best fit; False: one weighted blend (thesis)."""
     recenter_distance: float = 0.25 * INCH
     """A position error above this (m) is corrected by a recentering move: 1/4 in."""
     stabilization_finger: bool = False
     """Keep the free finger on the object during rotations (thesis 7.4.2)."""
     rolling_compensation: bool = True
-    """Shorten rotation arcs by r / (r + tip_radius) for the ball's rolling (thesis 7.2)."""
+    """Rotations follow the rolling ball tips (thesis 7.2); False: rigid arcs (thesis)."""
     success_angle_deg: float = 3.0
     """A gait succeeds when it ends within this of the planned orientation (deg)."""
 

@@ -31,10 +31,17 @@ One move at a time, for a Gymnasium env::
     report = ex.execute({"op": "regrasp", "contacts": {"1": 34.0, "3": 238.0}})
     report.status, report.pose_estimate
 
-Rolling: a fingertip ball that cannot spin rolls on the object, which then turns
-``(1 + rho / r)`` times as far as the fingers' arcs (thesis 7.2, ``rho`` the ball
-radius, ``r`` the contact radius: ~1/10 extra). With ``rolling_compensation`` on, the
-move sequences shorten the arcs by that factor so the object turns as planned.
+Rolling: a fingertip ball that cannot spin rolls on the object (thesis 7.2): its
+contact moves back along the contour as the object turns, ``rho theta`` on a flat edge,
+and on a circle the object turns ``(1 + rho / r)`` times as far as the fingers' arcs
+(``rho`` the ball radius, ``r`` the contact radius: ~1/10 extra). With
+``rolling_compensation`` on, the fingers follow the paths of their rolling balls
+(:func:`graspgait_env.contact_model.rolling_contacts_deg`), so that the object turns as
+planned; off, rigid arcs (the thesis, which neglected the rolling).
+
+Friction: the contacts' true friction is the plan's ``mu`` unless ``finger_mu`` sets
+another; the grip force and friction cone check (7.4.4) uses a cone narrowed by the
+hand's friction margin (:func:`check_cone_mu`) unless ``cone_mu`` sets one.
 """
 
 from __future__ import annotations
@@ -58,12 +65,35 @@ from graspgait_env.workspace import DEFAULT_WORKSPACES_DEG
 
 __all__ = ["GaitExecutor", "StepReport", "contact_angles_deg", "load_localizer",
            "random_pose_perturbation", "PERTURBATION_MAX_OFFSET_M",
-           "PERTURBATION_MAX_ANGLE_DEG", "THESIS_MU"]
+           "PERTURBATION_MAX_ANGLE_DEG", "THESIS_MU", "check_cone_mu"]
 
 THESIS_MU = 0.7  # friction coefficient of the thesis experiments' plans (thesis 7.5)
 PERTURBATION_MAX_OFFSET_M = 0.006  # (m) random placement error: an object "placed
 # approximately at the center" (thesis 7.2), within the 1/4 in that needs no recentring
 PERTURBATION_MAX_ANGLE_DEG = 5.0  # (deg) random placement error in angle
+
+
+def check_cone_mu(shape: Shape, plan_mu: float, config: SimConfig, mass: float) -> float:
+    """The friction coefficient of the grip force and friction cone check (thesis 7.4.4:
+    "the friction cone angle, which is an input into the program") when
+    ``config.cone_mu`` is None: the plan's cone narrowed by the hand's friction margin,
+    ``tan(atan(plan_mu) - margin)``, with ``margin`` the lean of a finger's force while
+    it carries a rotation's load across the object's shortest antipodal chord ``2
+    r_min`` (:meth:`ContactModel.margin_deg
+    <graspgait_env.contact_model.ContactModel.margin_deg>` of the hand's model; at
+    least half the cone is kept).
+
+    The check raises the grip only once a finger's commanded force has left its cone.
+    At the planning friction, a cone as wide as the true one fires when the contact is
+    already sliding: a 4 N tug across the circle's grip (3 N above what the nominal
+    grip holds) dropped it with the grip at 3.3 N; with the narrowed cone (0.55 for the
+    circle at mu 0.7) the grip rises in time and 5 N hold (tests/sim).
+    """
+    from graspgait_env.contact_model import hand_contact_model
+
+    margin = hand_contact_model(shape, config, mass_kg=mass).margin_deg(2.0 * shape.r_min)
+    half = math.atan(plan_mu)
+    return math.tan(max(half - math.radians(float(margin)), 0.5 * half))
 
 
 def random_pose_perturbation(rng: np.random.Generator,
@@ -86,7 +116,8 @@ class GaitExecutor:
         Object: a bundled name, a YAML path or a :class:`~graspgait_env.shapes.Shape`.
     mu
         The friction coefficient the plan was made with (``plan.mu``, default 0.7): the
-        friction cone check uses it unless ``config.cone_mu`` is set, and the physics
+        friction cone check narrows it (:func:`check_cone_mu`) unless ``config.cone_mu``
+        is set, and the physics
         too unless ``config.finger_mu`` sets the contacts' true friction.
     config
         A :class:`SimConfig`, a YAML path, or None for ``configs/sim/default.yaml``.
@@ -140,8 +171,9 @@ class GaitExecutor:
         self.max_r = self.sim.max_r
         self.state = ControllerState(self.sim.home.copy())
         self.monitor = GroundTruthMonitor(self.physics, cfg, self.state)
-        cone_mu = cfg.cone_mu if cfg.cone_mu is not None else self.plan_mu
-        self.loop = ServoLoop(self.physics, cfg, self.state, cone_mu, watch=self.monitor)
+        self.cone_mu = (cfg.cone_mu if cfg.cone_mu is not None
+                        else check_cone_mu(self.shape, self.plan_mu, cfg, mass))
+        self.loop = ServoLoop(self.physics, cfg, self.state, self.cone_mu, watch=self.monitor)
         self.loop.frame_callback = frame_callback
         self.moves = MoveSequencer(self.shape, cfg, self.physics, self.state, self.loop,
                                    self.workspaces, self.max_r, self.zc,

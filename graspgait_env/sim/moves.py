@@ -12,10 +12,10 @@ transition (a regrasp) and turns it into a sequence of trajectories
   rises to its nominal value;
 - **rotation** (:meth:`MoveSequencer.rotate`): the gripping fingers travel arcs about the
   estimated centre; the orientation error of the estimate is folded into the commanded
-  angle (7.4.5, 7.5), and the arcs are shortened for the rolling of the ball tips (7.2);
+  angle (7.4.5, 7.5), and each finger follows the path of its rolling ball tip (7.2);
 - **transition** (:meth:`MoveSequencer.regrasp`): the new finger arcs at ``max_r`` and
   approaches; the grip transfers from the old pair to the new with three fingers on
-  (the localizer runs then, 7.4.5); the old finger retreats; the object is recentred
+  (the localizer runs halfway, 7.4.5); the old finger retreats; the object is recentred
   when the estimate is off by more than 1/4 in (7.5); with ``stabilization_finger`` the
   free finger then rides on the object (7.4.2).
 
@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from graspgait_env.contact_model import rolling_contacts_deg
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.shapes import Shape
 from graspgait_env.sim import trajectory as tj
@@ -44,6 +45,9 @@ from graspgait_env.sim.state import ControllerState, MoveAborted, MoveOutcome, R
 from graspgait_env.sim.trajectory import CONTACT, FREE, HOLD, TRANSITION, pair_index
 
 __all__ = ["MoveSequencer", "contact_angles_deg", "load_localizer", "parse_contacts"]
+
+
+CONSTANT_SPEED_ACCEL = 1e6  # (m/s^2) the speed steps within one servo cycle: no ramp
 
 
 def contact_angles_deg(shape: Shape, tips_xy: NDArray[np.float64], pose: ArrayLike,
@@ -70,9 +74,10 @@ def load_localizer(shape: Shape, config: SimConfig
         from graspgait_env.sim.localizer import LocalizerConfig, ObjectLocalizer
     except ImportError:  # pragma: no cover - the localizer ships with the package
         return None
+    thesis = {} if config.localizer_iterate else {"max_iterations": 1, "gauss_newton": False}
     loc = ObjectLocalizer(shape, LocalizerConfig(
         tip_radius=config.tip_radius, allowable_error=config.recenter_distance,
-        prior_weight=config.localizer_prior_weight))
+        prior_weight=config.localizer_prior_weight, **thesis))
     return loc.localize
 
 
@@ -153,6 +158,13 @@ class MoveSequencer:
         self.localizer = localizer
         self.max_rotation_deg: float | None = None
 
+    def _accel(self, accel: float) -> float:
+        """A trajectory's acceleration limit (m/s^2): ``accel`` with ``trapezoidal_speed``,
+        else :data:`CONSTANT_SPEED_ACCEL`: the speed jumps to its constant value at a
+        trajectory's start and back to rest at its end, as the thesis's PD moved
+        (7.4.6: constant velocity between via points)."""
+        return accel if self.config.trapezoidal_speed else CONSTANT_SPEED_ACCEL
+
     # ------------------------------------------------------------------ geometry
     def _normals(self, fingers: list[int]) -> NDArray[np.float64]:
         """Inward normals (3, 2), frame F, at the estimated contacts of ``fingers``."""
@@ -164,6 +176,27 @@ class MoveSequencer:
         phi = contact_angles_deg(self.shape, tips, est, self.config.tip_radius)
         nr[fingers] = rotate_deg(self.shape.inward_normal(phi), est[2])
         return nr
+
+    def _rolling(self, fingers: list[int]) -> Callable[[NDArray[np.float64]], tuple]:
+        """The rolling of the ball tips of ``fingers`` (ascending) during a rotation
+        (thesis 7.2, :func:`~graspgait_env.contact_model.rolling_contacts_deg`): for
+        object turns ``a_deg`` ``(n,)``, each ball centre's shift on the object since
+        the start and the inward normals at the rolled contacts, ``(n, k, 2)`` each,
+        in frame F at the estimated angle."""
+        rho = self.config.tip_radius
+        est = self.state.est.copy()
+        tips = self.physics.tip_positions()[fingers, :2]
+        phi0 = contact_angles_deg(self.shape, tips, est, rho)
+        shape = self.shape
+
+        def roll(a_deg: NDArray[np.float64]) -> tuple:
+            phi = rolling_contacts_deg(shape, phi0[None, :], a_deg[:, None], rho)  # (n, k)
+            n_in = shape.inward_normal(phi)  # (n, k, 2)
+            ball = shape.contour_point(phi) - rho * n_in
+            shift = rotate_deg(ball - ball[:1], est[2])
+            return shift, rotate_deg(n_in, est[2])
+
+        return roll
 
     def _ball_target(self, phi_deg: float) -> NDArray[np.float64]:
         """Ball-centre point (3,) touching the contour at ``phi_deg`` on the estimated
@@ -201,7 +234,8 @@ class MoveSequencer:
         for tr in tj.approach(self.state.xd, fingers, targets, grip, normals, res=cfg.res,
                               speed=cfg.free_speed, approach_speed=cfg.approach_speed,
                               standoff=cfg.standoff, overshoot=cfg.overshoot,
-                              accel=cfg.free_accel, approach_accel=cfg.approach_accel,
+                              accel=self._accel(cfg.free_accel),
+                              approach_accel=self._accel(cfg.approach_accel),
                               hold=hold):
             names.append(tr.name)
             det = self._run(tr, stop_on_contact=stop_on_contact)
@@ -292,7 +326,7 @@ class MoveSequencer:
         targets = np.array([self._ball_target(a - st.est[2]) for a in ang])
         ta = np.degrees(np.arctan2(targets[:, 1] - st.est[1], targets[:, 0] - st.est[0]))
         tr = tj.free_arc(st.xd, fingers, st.est[:2], ta, self.max_r, zero, nz,
-                         res=cfg.res, speed=cfg.free_speed, accel=cfg.free_accel,
+                         res=cfg.res, speed=cfg.free_speed, accel=self._accel(cfg.free_accel),
                          workspaces=list(self.workspaces), kind=_kinds())
         names.append("probe_" + tr.name)
         self._run(tr)
@@ -310,7 +344,7 @@ class MoveSequencer:
             localized, rms = self.localize(fingers, assume_on=True)
             st.grip = zero.copy()
         tr = tj.retreat(st.xd, fingers, st.est[:2], self.max_r, zero, nz, res=cfg.res,
-                        speed=cfg.free_speed, accel=cfg.free_accel, kind=_kinds())
+                        speed=cfg.free_speed, accel=self._accel(cfg.free_accel), kind=_kinds())
         names.append(tr.name)
         self._run(tr)
         return localized, rms
@@ -334,14 +368,14 @@ class MoveSequencer:
         held = sorted(st.held)
         nr = self._normals(held)
         tr = tj.free_arc(st.xd, [f], st.est[:2], [ang], self.max_r, self._fold_grip(), nr,
-                         res=cfg.res, speed=cfg.free_speed, accel=cfg.free_accel,
+                         res=cfg.res, speed=cfg.free_speed, accel=self._accel(cfg.free_accel),
                          workspaces=[self.workspaces[f]], kind=_kinds(held))
         names.append("stabilizer_" + tr.name)
         self._run(tr)
         det = self._approach([f], target[None], self._fold_grip(), nr, held, names)
         if not det[f]:
             tr = tj.retreat(st.xd, f, st.est[:2], self.max_r, self._fold_grip(), nr,
-                            res=cfg.res, speed=cfg.free_speed, accel=cfg.free_accel,
+                            res=cfg.res, speed=cfg.free_speed, accel=self._accel(cfg.free_accel),
                             kind=_kinds(held))
             self._run(tr)
             return False, float("nan")
@@ -358,7 +392,7 @@ class MoveSequencer:
         held = sorted(st.held)
         tr = tj.retreat(st.xd, f, st.est[:2], self.max_r, self._fold_grip(),
                         self._normals(held), res=cfg.res, speed=cfg.free_speed,
-                        accel=cfg.free_accel, kind=_kinds(held))
+                        accel=self._accel(cfg.free_accel), kind=_kinds(held))
         names.append("stabilizer_" + tr.name)
         self._run(tr)
         st.stabilizer = None
@@ -384,7 +418,7 @@ class MoveSequencer:
             zero = np.zeros(3)
             tr = tj.free_arc(st.xd, fingers, st.est[:2], ang, self.max_r, zero,
                              np.zeros((3, 2)), res=cfg.res, speed=cfg.free_speed,
-                             accel=cfg.free_accel,
+                             accel=self._accel(cfg.free_accel),
                              workspaces=[self.workspaces[f] for f in fingers],
                              kind=_kinds())
             names.append(tr.name)
@@ -434,26 +468,24 @@ class MoveSequencer:
 
         The orientation error of the estimate (planned angle minus estimated angle) is
         added to the commanded rotation (thesis 7.4.5, 7.5); the fingers travel arcs
-        about the estimated centre at their present radius (7.4.2), shortened by
-        ``r / (r + tip_radius)`` with ``rolling_compensation`` (7.2).
+        about the estimated centre at their present radius (7.4.2), or, with
+        ``rolling_compensation``, the paths of their rolling ball tips (:meth:`_rolling`,
+        7.2): on a circle the arcs shortened by ``r / (r + tip_radius)``, on a flat edge
+        a path whose radius changes as the contact slides back along it.
         """
         cfg = self.config
         st = self.state
         t0 = self.physics.time
         fingers = sorted(st.held)
         cmd = delta_deg + (st.theta_goal - st.est[2])
-        arc = cmd
-        if cfg.rolling_compensation:
-            tips = self.physics.tip_positions()[fingers, :2]
-            phi = contact_angles_deg(self.shape, tips, st.est, cfg.tip_radius)
-            r = float(np.mean(self.shape.radius(phi)))
-            arc = cmd * r / (r + cfg.tip_radius)
         stab = [] if st.stabilizer is None else [st.stabilizer]
-        tr = tj.rotation(st.xd, st.est[:2], arc, fingers + stab, self._fold_grip(),
+        moving = sorted(fingers + stab)
+        rolling = self._rolling(moving) if cfg.rolling_compensation else None
+        tr = tj.rotation(st.xd, st.est[:2], cmd, moving, self._fold_grip(),
                          self._normals(fingers),
                          res=cfg.res, speed_deg=cfg.rotation_speed_deg,
-                         accel=cfg.rotation_accel,
-                         max_speed=cfg.free_speed, kind=_kinds(fingers, transition=stab))
+                         accel=self._accel(cfg.rotation_accel), max_speed=cfg.free_speed,
+                         kind=_kinds(fingers, transition=stab), rolling=rolling)
         localized, rms = False, float("nan")
         try:
             self._run(tr)
@@ -496,7 +528,7 @@ class MoveSequencer:
             target = self._ball_target(new[n])
             ang = math.degrees(math.atan2(target[1] - st.est[1], target[0] - st.est[0]))
             tr = tj.free_arc(st.xd, [n], st.est[:2], [ang], self.max_r, g, nr,
-                             res=cfg.res, speed=cfg.free_speed, accel=cfg.free_accel,
+                             res=cfg.res, speed=cfg.free_speed, accel=self._accel(cfg.free_accel),
                              workspaces=[self.workspaces[n]], kind=_kinds([k, lifted]))
             names.append(tr.name)
             self._run(tr)
@@ -505,24 +537,37 @@ class MoveSequencer:
                 return MoveOutcome("regrasp", "no-contact", t0, [k, lifted],
                                    message=f"finger {n + 1} found no object",
                                    trajectories=names)
-            # 2. three fingers on: the grip moves from the old pair to the new
+            # 2. three fingers on: the grip moves from the old pair to the new; halfway,
+            # when all three fingers push on the object (both pairs grip), the object
+            # localizer runs (7.4.5). After the transfer the lifted finger no longer
+            # pushes (it servos to where it stood), so it may have left the object.
             nr = self._normals([k, lifted, n])
             g_new = self._grip_vector(new_pair, cfg.grip_force)
-            tr = tj.transfer(st.xd, self._fold_grip(), g_new, nr, cfg.transfer_time,
+            g_old = self._fold_grip()
+            mid = cfg.localize_during_transfer
+            t1 = 0.5 * cfg.transfer_time if mid else cfg.transfer_time
+            tr = tj.transfer(st.xd, g_old, 0.5 * (g_old + g_new) if mid else g_new, nr, t1,
                              kind=np.full(3, TRANSITION))
             names.append(tr.name)
             self._run(tr)
+            if mid:
+                # 3. the object localizer, all three fingers on the object (7.4.5)
+                localized, rms = self.localize([k, lifted, n])
+                tr = tj.transfer(st.xd, self._fold_grip(), g_new, nr, cfg.transfer_time - t1,
+                                 kind=np.full(3, TRANSITION))
+                names.append(tr.name)
+                self._run(tr)
             st.held = {k: st.held[k], n: new[n]}
             tr = tj.hold(st.xd, self._fold_grip(), nr, cfg.settle_time,
                          _kinds([k, n], transition=[lifted]))
             names.append(tr.name)
             self._run(tr)
-            # 3. the object localizer, all three fingers on the object (7.4.5)
-            localized, rms = self.localize([k, lifted, n])
+            if not mid:  # 3. after the transfer: the lifted finger may push no longer
+                localized, rms = self.localize([k, lifted, n])
             # 4. the old finger leaves along a line outward
             nr = self._normals([k, n])
             tr = tj.retreat(st.xd, lifted, st.est[:2], self.max_r, self._fold_grip(), nr,
-                            res=cfg.res, speed=cfg.free_speed, accel=cfg.free_accel,
+                            res=cfg.res, speed=cfg.free_speed, accel=self._accel(cfg.free_accel),
                             kind=_kinds([k, n]))
             names.append(tr.name)
             self._run(tr)
@@ -531,7 +576,7 @@ class MoveSequencer:
             if float(np.hypot(*err)) > cfg.recenter_distance:
                 tr = tj.translate(st.xd, [k, n], err, self._fold_grip(), nr,
                                   res=cfg.res, speed=cfg.recenter_speed,
-                                  accel=cfg.rotation_accel, kind=_kinds([k, n]))
+                                  accel=self._accel(cfg.rotation_accel), kind=_kinds([k, n]))
                 names.append(tr.name)
                 self._run(tr)
                 st.est[:2] += err

@@ -109,7 +109,7 @@ class ServoLoop:
         armed = [k == CONTACT for k in kind]
         detecting = any(armed)
         directions: list[tuple[float, float] | None] = [None, None, None]
-        if detecting:  # approach direction of each armed finger (its straight path)
+        if detecting and cfg.contact_along_approach:  # each armed finger's approach line
             for f in range(3):
                 d = xd_all[-1, f, :2] - xd_all[0, f, :2]
                 n = math.hypot(d[0], d[1])

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -37,31 +38,65 @@ from graspgait_env.sim.executor import (
 
 __all__ = ["simulate_plan", "simulate_command", "parse_perturbation", "benchmark_step_rate",
            "format_result", "default_plan", "tug_test", "perturbation_limits",
-           "check_perturbation", "check_video_path", "VideoRecorder", "VIDEO_SUFFIX"]
+           "check_perturbation", "check_video_path", "point_contact_warning", "VideoRecorder",
+           "VIDEO_SUFFIX"]
 
 VIDEO_SUFFIX = ".mp4"  # the container simulate_plan writes (imageio's FFMPEG plugin)
 TUG_REPORT_S = 0.05  # (s) the tug test holds in pieces this long, checking contact after each
 
 
 class VideoRecorder:
-    """Renders frames of a :class:`~graspgait_env.sim.model.HandPhysics` into an
-    imageio writer (headless: set ``MUJOCO_GL=egl`` before MuJoCo is imported)."""
+    """Renders frames of a run into an imageio writer, with the overlays of
+    :class:`~graspgait_env.sim.view.HandView` (headless: ``MUJOCO_GL=egl`` before MuJoCo
+    is imported, as :mod:`graspgait_env.sim` sets it).
 
-    def __init__(self, model, writer, *, width: int, height: int, camera: str) -> None:
-        import mujoco
+    Parameters
+    ----------
+    executor
+        The executor whose physics is drawn; its true object angle (monitoring) is the
+        angle in the caption.
+    writer
+        An imageio writer (``append_data``).
+    width, height
+        Frame size (px).
+    camera
+        An MJCF camera name (``config.video_camera``); None: straight above, as
+        ``GraspGaitMujoco-v0`` renders.
+    plan
+        The plan run, for the captions (object, friction, the turn asked for, move
+        *i* of *n*); :attr:`move` is set by :func:`simulate_plan` before each step.
+    """
 
-        self.renderer = mujoco.Renderer(model, height=height, width=width)
+    def __init__(self, executor: GaitExecutor, writer, *, width: int, height: int,
+                 camera: str | None, plan: Plan) -> None:
+        from graspgait_env.sim.view import HandView
+
+        self.view = HandView(executor.sim, width=width, height=height, camera=camera)
+        self.executor = executor
         self.writer = writer
-        self.camera = camera
+        self.plan = plan
+        self.move = 0  # the plan step being executed (0: the grasp)
         self.frames = 0
 
+    def caption(self) -> list[str]:
+        """The caption lines of the present frame."""
+        ex, plan = self.executor, self.plan
+        n = len(plan.steps) - 1  # the moves after the initial grasp
+        op = plan.steps[self.move].get("op", "?") if self.move < len(plan.steps) else "end"
+        lines = [f"{plan.object}: plan mu={plan.mu:g}, finger mu={ex.mu:g}",
+                 f"theta={ex.theta_true:.1f} deg (true) of {plan.rotation_deg:g}",
+                 f"move {self.move} of {n}: {op}" if self.move else f"grasp (moves: {n})",
+                 f"t={ex.time:.2f} s"]
+        if ex.dropped:
+            lines.append("DROPPED")
+        return lines
+
     def __call__(self, physics) -> None:
-        self.renderer.update_scene(physics.data, camera=self.camera)
-        self.writer.append_data(self.renderer.render())
+        self.writer.append_data(self.view.render(physics, self.caption()))
         self.frames += 1
 
     def close(self) -> None:
-        self.renderer.close()
+        self.view.close()
 
 
 def _resolve_config(config: SimConfig | str | os.PathLike | None) -> SimConfig:
@@ -145,11 +180,12 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
         def write(fh) -> None:
             with iio.imopen(fh, "w", extension=".mp4", plugin="FFMPEG") as out:
                 writer = out.legacy_get_writer(fps=cfg.video_fps, macro_block_size=8)
-                rec = VideoRecorder(ex.sim.model, writer, width=cfg.video_width,
-                                    height=cfg.video_height, camera=cfg.video_camera)
+                rec = VideoRecorder(ex, writer, width=cfg.video_width,
+                                    height=cfg.video_height, camera=cfg.video_camera,
+                                    plan=plan)
                 ex.frame_callback = rec
                 try:
-                    result.update(_execute(ex, plan, pert, progress))
+                    result.update(_execute(ex, plan, pert, progress, recorder=rec))
                     for _ in range(int(cfg.video_tail_s * cfg.video_fps)):  # the end, held
                         rec(ex.physics)
                 finally:
@@ -166,7 +202,7 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
 
 
 def _execute(ex: GaitExecutor, plan: Plan, pert: tuple[float, float, float],
-             progress: bool) -> dict[str, Any]:
+             progress: bool, recorder: VideoRecorder | None = None) -> dict[str, Any]:
     from tqdm import tqdm
 
     cfg = ex.config
@@ -181,9 +217,11 @@ def _execute(ex: GaitExecutor, plan: Plan, pert: tuple[float, float, float],
         theta0 = pert[2]
         reports.append(rep)
         bar.update(1)
-        for st in plan.steps[1:]:
+        for i, st in enumerate(plan.steps[1:], start=1):
             if not rep.ok:
                 break
+            if recorder is not None:
+                recorder.move = i  # for the video's caption
             rep = ex.execute(st)
             reports.append(rep)
             bar.update(1)
@@ -474,6 +512,21 @@ def check_video_path(video: str | os.PathLike) -> Path:
     return check_output_path("--video", video, (VIDEO_SUFFIX,))
 
 
+def point_contact_warning(plan: Plan, source: str | os.PathLike = "the plan") -> str | None:
+    """A one-line warning when ``plan`` was made for the thesis's point contacts (no
+    ``contact_model`` ``"hand"`` recorded, docs/formats.md), else None.
+
+    Point-contact grasps may sit at the edge of the friction cone and next to vertices;
+    the hand's ball tips roll and carry the rotations' load, and at finger friction = mu
+    (the default) they drop such plans (measured: 0 of 24 perturbed runs of the four
+    thesis objects' rule-based and optimal gaits held, README "Running on the hand").
+    """
+    if plan.assumed_contact_model.is_point:
+        return (f"{source} was planned for point contacts (no contact_model 'hand'); the "
+                "hand may drop it at finger friction = mu: plan without --point-contacts")
+    return None
+
+
 def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
                      seed: int = 0, perturb: str | None = None, config: str | None = None,
                      json_out: str | None = None, progress: bool = True) -> int:
@@ -496,6 +549,9 @@ def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
     check_perturbation(pert, load_object(plan.object), cfg)
     if video is not None:
         check_video_path(video)
+    warning = point_contact_warning(plan, plan_path)
+    if warning:
+        print(f"graspgait: warning: {warning}", file=sys.stderr)
     result = simulate_plan(plan, video=video, seed=seed, pose_perturbation=pert,
                            config=cfg, progress=progress)
     print(format_result(result))
@@ -505,24 +561,26 @@ def simulate_command(plan_path: str | os.PathLike, *, video: str | None = None,
     return 0 if result["success"] else 1
 
 
-PLAN_VERTEX_CLEARANCE_DEG = 4.0  # (degrees) keep planned contacts off polygon corners
-
-
 def default_plan(object: str = "ellipse", mu: float = THESIS_MU, planner: str = "optimal",
-                 vertex_clearance_deg: float = PLAN_VERTEX_CLEARANCE_DEG) -> Plan:
+                 config: SimConfig | str | os.PathLike | None = None,
+                 contact_model: str = "hand") -> Plan:
     """The 360° gait of ``object`` at ``mu`` by ``planner``
-    (:mod:`graspgait_env.planners.registry`), for the physical hand: contacts stay
-    ``vertex_clearance_deg`` away from polygon vertices.
+    (:mod:`graspgait_env.planners.registry`), as ``graspgait plan`` makes it: for the
+    hand's contact model (:func:`graspgait_env.contact_model.hand_contact_model` of
+    ``config``, default ``configs/sim/default.yaml``), or ``contact_model="point"`` for
+    the thesis's point contacts.
 
-    The thesis's point contacts may sit next to a corner; the 7.8 mm ball tip rolls along
-    the contour as the object turns (about 6 mm over a 90° rotation) and rolls off it.
-    Measured here: the pentagon's rule plan at 0° clearance drops in 10 of 10 perturbed
-    runs; at 4° it succeeds in 10 of 10 (8° leaves too little of each edge: 4 of 10).
+    Raises
+    ------
+    GraspGaitInputError
+        The planner finds no gait.
     """
+    from graspgait_env.contact_model import contact_model_named
     from graspgait_env.gait import GaitModel
     from graspgait_env.planners.registry import run_planner
 
-    model = GaitModel(object, mu, vertex_clearance_deg=vertex_clearance_deg)
+    cm = contact_model_named(contact_model, object, _resolve_config(config))
+    model = GaitModel(object, mu, contact_model=cm)
     res = run_planner(planner, model, None, 360.0)
     if res.plan is None:
         raise GraspGaitInputError(f"{planner} planner found no gait for {object} at "

@@ -32,6 +32,7 @@ in the public arguments.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -226,13 +227,23 @@ def _n_points(length: float, res: float) -> int:
 def rotation(x0: NDArray[np.float64], center: ArrayLike, delta_deg: float,
              moving: ArrayLike, grip: ArrayLike, normals: NDArray[np.float64], *,
              res: float, speed_deg: float, accel: float, max_speed: float | None = None,
-             kind: ArrayLike | None = None) -> Trajectory:
+             kind: ArrayLike | None = None,
+             rolling: Callable[[NDArray[np.float64]], tuple[NDArray[np.float64],
+                                                            NDArray[np.float64]]] | None = None
+             ) -> Trajectory:
     """An object rotation: the ``moving`` fingers travel arcs about ``center`` at their
     present radius through ``delta_deg`` (CCW positive); the others stay (7.4.2).
 
     ``normals`` (3, 2) are rotated along. The angular speed is limited to
     ``speed_deg`` deg/s, and the fastest tip to ``max_speed`` m/s if given;
     ``accel`` limits the tip acceleration.
+
+    ``rolling``: for ball tips that roll on the object (thesis 7.2), a function of the
+    object angles ``a_deg`` ``(n,)`` (0 .. ``delta_deg``) returning ``(shift, normals)``,
+    each ``(n, k, 2)`` for the ``k`` moving fingers in ascending order, in the frame of
+    the object at the start of the rotation: how far each ball centre has moved on the
+    object since the start (m), and the inward normals at the rolled contacts. Each
+    moving finger then follows ``center + R(a) (rel + shift)`` instead of the rigid arc.
     """
     x0 = np.asarray(x0, dtype=np.float64)
     c = np.asarray(center, dtype=np.float64)[:2]
@@ -246,9 +257,16 @@ def rotation(x0: NDArray[np.float64], center: ArrayLike, delta_deg: float,
     a = np.linspace(0.0, d, n)
     R = rotation_matrices(a)  # (n, 2, 2)
     paths = np.broadcast_to(x0, (n, 3, 3)).copy()
-    paths[:, mv, :2] = c + np.einsum("nij,fj->nfi", R, rel[mv])
     nr = np.broadcast_to(np.asarray(normals, dtype=np.float64), (3, 2))
-    nrm = np.einsum("nij,fj->nfi", R, nr)
+    if rolling is None:
+        paths[:, mv, :2] = c + np.einsum("nij,fj->nfi", R, rel[mv])
+        nrm = np.einsum("nij,fj->nfi", R, nr)
+    else:
+        shift, n_roll = rolling(np.degrees(a))
+        paths[:, mv, :2] = c + np.einsum("nij,nfj->nfi", R, rel[mv][None] + shift)
+        nr_n = np.broadcast_to(nr, (n, 3, 2)).copy()
+        nr_n[:, mv] = n_roll
+        nrm = np.einsum("nij,nfj->nfi", R, nr_n)
     vlim = math.radians(speed_deg) * max(rmax, 1e-9)
     if max_speed is not None:
         vlim = min(vlim, max_speed)

@@ -69,16 +69,16 @@ def test_orientation_error_is_folded_into_the_next_rotation():
 
 def test_one_move_at_a_time():
     """The API a Gymnasium env uses: reset(grasp), execute(step) -> StepReport."""
-    ex = GaitExecutor("ellipse", mu=0.7)
-    rep = ex.execute({"op": "grasp", "contacts": {"1": 34.0, "2": 208.0}})
-    assert rep.ok and rep.op == "grasp" and set(rep.touching) == {1, 2}
-    rep = ex.execute({"op": "rotate", "delta": 10.0})
-    assert rep.ok and rep.pose_estimate[2] == pytest.approx(10.0)
-    rep = ex.execute({"op": "regrasp", "contacts": {"1": 34.0, "3": 238.0}})
-    assert rep.ok and set(rep.touching) == {1, 3} and rep.localized
-    assert sorted(ex.held) == [0, 2]
+    ex = GaitExecutor("ellipse", mu=0.7)  # the first moves of its plan for the hand
+    rep = ex.execute({"op": "grasp", "contacts": {"1": 60.0, "3": 240.0}})
+    assert rep.ok and rep.op == "grasp" and set(rep.touching) == {1, 3}
+    rep = ex.execute({"op": "rotate", "delta": 30.0})
+    assert rep.ok and rep.pose_estimate[2] == pytest.approx(30.0)
+    rep = ex.execute({"op": "regrasp", "contacts": {"2": 90.0, "3": 240.0}})
+    assert rep.ok and set(rep.touching) == {2, 3} and rep.localized
+    assert sorted(ex.held) == [1, 2]
     assert abs(rep.pose_true[2] - rep.pose_estimate[2]) < 1.0
-    assert rep.grip_n[1] >= 2.0 and rep.grip_n[0] == 0.0  # pair (1, 3) grips
+    assert rep.grip_n[2] >= 2.0 and rep.grip_n[:2] == (0.0, 0.0)  # pair (2, 3) grips
     assert "transfer" in rep.trajectories and "retreat" in rep.trajectories
     d = rep.to_dict()
     assert d["status"] == "ok" and d["op"] == "regrasp"
@@ -158,9 +158,11 @@ def test_simulate_plan_refuses_bad_input():
 
 
 # ----------------------------------------------------------------- tug test (thesis 7.5)
+# At finger friction 0.7 the check can raise the grip to 1 lb (4.45 N), so the two
+# fingers hold at most 2 x 0.7 x 4.45 = 6.2 N across the grip: a 5 N tug is 80% of that.
 @pytest.mark.parametrize("along", [False, True], ids=["across-grip", "along-grip"])
 def test_tug_with_the_check_on_holds(along):
-    r = tug_test("circle", force=6.0, along_grip=along, grip_check=True)
+    r = tug_test("circle", force=5.0, along_grip=along, grip_check=True)
     assert not r["dropped"] and not r["lost_contact"]
     assert r["slip_m"] <= 0.002  # measured ~0.1-0.3 mm
     assert r["max_grip_n"] > 2.0  # the check raised the grip
