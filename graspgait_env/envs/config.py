@@ -220,6 +220,11 @@ class GraspGaitConfig:
     """Cost of a dead end, a drop or passing the wrong-way limit (reward units, >= 0)."""
     illegal_penalty: float = 0.1
     """Cost of an illegal action, a no-op (reward units per action, >= 0)."""
+    to_go_weight: float = 0.0
+    """Reward per regrasp gained towards the goal (reward units, >= 0; 0: off, the
+    default): a regrasp earns ``to_go_weight * (before - after)``, the fall in the fewest
+    regrasps still needed to reach the turn (the exact optimum's count, beyond the
+    thesis; see the env's *Rewards*)."""
     max_backward_deg: float = 360.0
     """Wrong-way limit: the episode ends past this turn against the goal (degrees, > 0)."""
     map_window_deg: float = 360.0
@@ -227,6 +232,15 @@ class GraspGaitConfig:
     map_window_cells: int = 36
     """Cells per side of the grasp-map window (an integer >= 1, at most the grid points
     in ``map_window_deg``)."""
+    map_lines: bool = False
+    """Append the grasp map's two lines through the grasp (``2 n`` entries, in the hand
+    frame; see the env's *Observation Space*). False (the default): no lines."""
+    contact_model: str = "point"
+    """What the fingertips are in the grasp map (:mod:`graspgait_env.contact_model`):
+    ``"point"``, the thesis's point contacts (``GraspGait-v0``'s default); ``"hand"``, the
+    simulated hand's rolling ball tips with the friction margin its rotations need, so
+    that what is learned on the map runs on the hand (``GraspGaitMujoco-v0``'s
+    default)."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -246,7 +260,7 @@ class GraspGaitConfig:
             raise GraspGaitInputError(str(exc)) from None
         put("alpha", check_number("alpha", self.alpha, 1.0))
         for name, example in (("beta", 0.01), ("gamma", 0.01), ("dead_end_penalty", 1.0),
-                              ("illegal_penalty", 0.1)):
+                              ("illegal_penalty", 0.1), ("to_go_weight", 0.1)):
             put(name, check_number(name, getattr(self, name), example, minimum=0.0,
                                    why="it is subtracted as a cost"))
         if self.turn_scale_deg is not None:
@@ -260,6 +274,15 @@ class GraspGaitConfig:
                                            minimum=0.0, strict=True, maximum=360.0,
                                            why="degrees; 360 is the whole map"))
         put("map_window_cells", check_count("map_window_cells", self.map_window_cells, 1, 36))
+        if not isinstance(self.map_lines, (bool, np.bool_)):
+            raise GraspGaitInputError(f"map_lines={self.map_lines!r}: must be True or False")
+        put("map_lines", bool(self.map_lines))
+        from graspgait_env.contact_model import CONTACT_MODELS
+
+        if self.contact_model not in CONTACT_MODELS:
+            raise GraspGaitInputError(
+                f"contact_model={self.contact_model!r}: use 'point' (the thesis's point "
+                "contacts) or 'hand' (the simulated hand's ball tips)")
         self.window_stride()
 
     # ------------------------------------------------------------------ derived values
@@ -287,6 +310,21 @@ class GraspGaitConfig:
                 f"map_window_deg={self.map_window_deg:g} at n={self.n}; use at most "
                 f"{max(1, min(self.n, span))} cells")
         return s
+
+    def planning_contact_model(self, object: str | os.PathLike | Shape,  # noqa: A002
+                               sim_config: Any = None):
+        """The :class:`~graspgait_env.contact_model.ContactModel` that ``contact_model``
+        names for ``object`` with this config's hand and turn (``"hand"``: from
+        ``sim_config``, default ``configs/sim/default.yaml``)."""
+        from graspgait_env.contact_model import contact_model_named
+        from graspgait_env.objects import load_object
+        from graspgait_env.workspace import load_hand
+
+        if self.contact_model == "point":
+            return contact_model_named("point", object)
+        hand, _ = load_hand(self.hand, load_object(object))
+        return contact_model_named("hand", object, sim_config,
+                                   workspaces_deg=hand.workspaces_deg, turn_deg=self.turn_deg)
 
     # ------------------------------------------------------------------ construction
     @classmethod

@@ -31,6 +31,7 @@ from graspgait_env.envs.config import (
 )
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import REGRASP, ROTATE, GaitModel, GaitState
+from graspgait_env.planners.exact import RegraspsToGo
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand
 
@@ -61,14 +62,14 @@ class ObservationLayout:
 
     Attributes
     ----------
-    held, position, contact_cos_sin, theta_cos_sin, achieved, to_go, mask, window
+    held, position, contact_cos_sin, theta_cos_sin, achieved, to_go, mask, window, lines
         Slices (``achieved`` and ``to_go`` are indices); ``window`` reshapes to
-        ``(cells, cells)``.
+        ``(cells, cells)``, ``lines`` (``map_lines``; else empty) to ``(2, n)``.
     size
         Length of the observation vector.
     """
 
-    def __init__(self, n_actions: int, cells: int) -> None:
+    def __init__(self, n_actions: int, cells: int, line_cells: int = 0) -> None:
         self.held = slice(_HELD, _HELD + 3)
         self.position = slice(_POS, _POS + 3)
         self.contact_cos_sin = slice(_PHI, _PHI + 6)
@@ -77,8 +78,10 @@ class ObservationLayout:
         self.to_go = _TO_GO
         self.mask = slice(_HEADER, _HEADER + n_actions)
         self.window = slice(_HEADER + n_actions, _HEADER + n_actions + cells * cells)
+        end = self.window.stop
+        self.lines = slice(end, end + 2 * line_cells)  # empty unless map_lines
         self.cells = cells
-        self.size = _HEADER + n_actions + cells * cells
+        self.size = end + 2 * line_cells
 
 
 class ResetNeededError(gym.error.ResetNeeded, RuntimeError):
@@ -173,7 +176,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     ## Observation Space
 
-    A flat ``Box(float32)`` of length ``16 + n_actions + cells**2`` (1494 by default),
+    A flat ``Box(float32)`` of length ``16 + n_actions + cells**2`` (1494 by default;
+    ``2 n`` more with ``map_lines``),
     every entry inside its bounds. Fingers ``f = 1, 2, 3``; ``T`` = ``turn_deg``;
     ``sigma = sign(T)``; ``B`` = ``max_backward_deg``; ``Δ = 360 / n``; ``θ`` the object
     angle (degrees, CCW).
@@ -194,6 +198,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     | 16 .. 15+A    | legal-move mask (1: legal), ``A = n_actions``| 0            | 1            |
     | 16+A ..       | grasp-map window, ``C x C`` cells, row-major | 0            | 1            |
     | 15+A+C²       | (see below)                                  |              |              |
+    | 16+A+C² ..    | with ``map_lines``: the grasp map's lines    | 0            | 1            |
+    | 15+A+C²+2n    | through the grasp (see below), ``2 x n``     |              |              |
 
     With the defaults (``T = B = 360°``, ``R Δ = 90°``) the turn achieved lies in
     ``[-1.25, 1.25]`` and the turn to go in ``[0, 2.25]``.
@@ -208,6 +214,16 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     ``F`` and the object frame: the window is the map as seen from the current grasp,
     the same for every object, which lets one policy work across objects. Regrasp
     targets reachable now are in the mask; the window shows what lies beyond.
+
+    The **map lines** (``map_lines=True``; off by default) are the grasp map's row and
+    column through the present grasp at grid resolution: the regrasps of thesis 4.3,
+    horizontal and vertical moves in the map. Line 0 belongs to the lower-numbered held
+    finger ``f``, line 1 to the higher ``g``; entry ``j`` is 1 when the held contact and
+    the contact that hand-frame angle ``j Δ`` touches now, ``(j - k) mod n``, form a
+    force-closure grasp. So the regrasp placing the free finger at workspace position
+    ``p`` and keeping ``f`` (``l = 1``) is legal exactly when line 0 is 1 at ``j = s_h +
+    p`` (keeping ``g``: line 1); a rotation by ``d`` steps shifts both lines by ``d``,
+    so they show which regrasps a rotation would open, over the whole circle.
 
     With the held fingers, positions and turn achieved the observation determines the
     state exactly: :func:`state_from_observation`.
@@ -224,7 +240,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     |-------------|---------------------------------------------------------------------------|
     | ``turn``    | ``alpha * Δθ* / turn_scale_deg``: turn gained towards the goal (degrees), |
     |             | with θ* = ``min(sigma θ, abs(T))`` so overshoot earns nothing             |
-    | ``regrasp`` | ``-beta`` for a regrasp                                                   |
+    | ``regrasp`` | ``-beta`` for a regrasp, ``+ to_go_weight * (G0 - G1)`` (below)          |
     | ``rotation``| ``-gamma`` for a rotation                                                 |
     | ``success`` | ``+success_bonus`` on reaching the turn                                   |
     | ``dead_end``| ``-dead_end_penalty`` on a dead end or on passing the wrong-way limit     |
@@ -233,6 +249,19 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     With ``turn_scale_deg=1`` and ``alpha = beta = gamma = 1`` the first three terms sum
     over an episode to the thesis's ``M`` (the thesis found all equal to 1 satisfactory);
     the defaults scale the turn to 1 for the whole turn and keep β, γ small.
+
+    **Regrasps priced against the optimum** (beyond the thesis; off by default): with
+    ``to_go_weight > 0`` each regrasp also earns ``to_go_weight * (G0 - G1)``, where
+    ``G`` is the fewest regrasps still needed to reach the turn before (``G0``) and after
+    (``G1``) it, the exact planner's count
+    (:class:`~graspgait_env.planners.exact.RegraspsToGo`, one table per object, built at
+    construction and, in ``GraspGaitRandom-v0``, at every reset). A regrasp of an
+    optimal gait gains 1; one that gains nothing or leads away earns 0 or less. Over a
+    successful episode these sum to ``to_go_weight * G(start)`` whatever the path (a
+    potential-based shaping, Ng et al. 1999), so the optimum's count only guides
+    learning: what a wasted regrasp costs is still ``beta`` and the discount. It never
+    enters the observation. From a grasp with no gait ``G`` is undefined and the
+    extra term is 0.
 
     ## Starting State
 
@@ -265,7 +294,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     :class:`~graspgait_env.envs.config.GraspGaitConfig` (each documented there, with its
     units): ``hand=None, turn_deg=360.0, n=180, alpha=1.0, beta=0.01, gamma=0.01,
     turn_scale_deg=None, success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1,
-    max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36``.
+    to_go_weight=0.0, max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36,
+    map_lines=False``.
 
     - ``object``: bundled name (``"ellipse"``, the thesis's fig. 5.3 ellipse), YAML path
       or :class:`~graspgait_env.shapes.Shape`.
@@ -276,14 +306,20 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
       (default: thesis fig. 4.1); ``turn_deg``: requested turn (sign = direction);
       ``n``: grid size.
     - ``alpha, beta, gamma, turn_scale_deg`` (default ``abs(turn_deg)``),
-      ``success_bonus, dead_end_penalty, illegal_penalty``: reward weights (above).
+      ``success_bonus, dead_end_penalty, illegal_penalty, to_go_weight``: reward
+      weights (above).
     - ``max_backward_deg``: wrong-way limit (above).
     - ``map_window_deg, map_window_cells``: span and resolution of the grasp-map window.
-    - ``render_mode``: ``"rgb_array"`` returns an ``(H, W, 3)`` uint8 frame: the object
-      in the workspace frame with the three workspaces and the fingers, and the extended
-      grasp map (finger pair boxes at the present θ) with the gait so far. ``"human"``
-      shows the same frame in a matplotlib window when an interactive backend is
-      available; headless (Agg backend, no display) it shows nothing and warns once.
+    - ``map_lines``: append the grasp map's two lines through the grasp (above).
+    - ``render_mode``: ``"rgb_array"`` returns a ``(480, 640, 3)`` uint8 frame: the
+      object in the workspace frame with the three workspaces and the fingers, and the
+      extended grasp map (finger pair boxes at the present θ) with the gait so far
+      (:class:`~graspgait_env.envs.render.GaitFrames`: the fixed parts are drawn once
+      per model, a frame costs a few ms). ``"human"`` shows the same frame in a
+      matplotlib window when an interactive backend is available; headless (Agg
+      backend, no display) it shows nothing and warns once. One frame per move:
+      ``metadata["render_fps"]`` (4) is the rate of human mode and of a video recorded
+      with Gymnasium's ``RecordVideo``, four moves per second.
 
     Every argument is checked at construction: a bad value raises ``ValueError``
     (:class:`~graspgait_env.errors.GraspGaitInputError`) naming it, the value and the
@@ -313,9 +349,14 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         **fields: Any,
     ) -> None:
         self._configure(config, render_mode, fields)
-        self._use_model(GaitModel(check_object(object), check_mu(mu), self.config.hand,
-                                  self.config.n))
+        obj = check_object(object)
+        self._use_model(GaitModel(obj, check_mu(mu), self.config.hand, self.config.n,
+                                  contact_model=self._planning_contact_model(obj)))
         self._make_spaces()
+
+    def _planning_contact_model(self, object: str | os.PathLike | Shape):  # noqa: A002
+        """The grasp maps' contact model: ``config.contact_model`` for ``object``."""
+        return self.config.planning_contact_model(object)
 
     # ------------------------------------------------------------------ set-up
     def _configure(self, config: GraspGaitConfig | None, render_mode: str | None,
@@ -334,6 +375,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 f"{' or '.join(map(repr, self.metadata['render_modes']))}")
         self.render_mode = render_mode
         self._renderer = None  # render.GaitRenderer, made by the first human-mode render()
+        self._frames = None  # render.GaitFrames of the present model, made by render()
         self._mask: NDArray[np.bool_] | None = None  # None: reset() needed
         self.model: GaitModel
 
@@ -381,11 +423,18 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._win_back = s * (cells // 2) + s // 2
         self._win_len = s * cells
         self._pooled = _pooled_map(model.stable, s)
+        # the map's rows tiled twice: a held contact's line at angle k is one slice
+        self._line_src = (np.tile(model.stable, (1, 2)).astype(np.float32)
+                          if cfg.map_lines else None)
         self._starts: list[GaitState] | None = None
+        # regrasps to go from every state (the exact optimum's count; only when rewarded)
+        self._to_go = (RegraspsToGo(model, cfg.turn_deg, cfg.max_backward_deg)
+                       if cfg.to_go_weight > 0 else None)
+        self._gained = 0  # regrasps gained towards the goal by the move rewarded (_reward)
 
     def _make_spaces(self) -> None:
         A, C = self._A, self.config.map_window_cells
-        self.layout = ObservationLayout(A, C)
+        self.layout = ObservationLayout(A, C, self._n if self.config.map_lines else 0)
         lo = np.zeros(self.layout.size, dtype=np.float64)
         hi = np.ones(self.layout.size, dtype=np.float64)
         lo[_POS:_THETA + 2] = -1.0
@@ -398,6 +447,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
+        self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
 
     def _check_model_fits(self, model: GaitModel) -> None:
         if int(model.n_actions) != self.action_space.n or model.n != self._n:
@@ -474,6 +524,10 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         km = k % self._n
         o[_THETA] = self._cos[km]
         o[_THETA + 1] = self._sin[km]
+        if self._line_src is not None:  # thesis 4.3: the regrasps keeping f or g
+            m = -k % self._n  # F angle j touches contact (j - k) mod n
+            self._line_view[0] = self._line_src[self._c[f], m:m + self._n]
+            self._line_view[1] = self._line_src[self._c[g], m:m + self._n]
         t = self._sign * k
         o[_ACHIEVED] = t / self._Kabs
         o[_TO_GO] = max(0, self._Kabs - t) / self._Kabs
@@ -510,6 +564,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         # thesis 5.4: alpha * theta, the turn towards the goal, overshoot earning nothing
         turn = self._turn_coef * ((t1 if t1 < K else K) - (t0 if t0 < K else K))
         regrasp = -cfg.beta if move is REGRASP else 0.0  # thesis 5.4: - beta * regrasps
+        if move is REGRASP and self._to_go is not None:  # priced against the optimum
+            regrasp += cfg.to_go_weight * self._gained
+            self._gained = 0  # a regrasp whose outcome step() did not set gains nothing
         rotation = -cfg.gamma if move is ROTATE else 0.0  # thesis 5.4: - gamma * rotations
         illegal = -cfg.illegal_penalty if move is None else 0.0
         success = dead_end = 0.0
@@ -606,6 +663,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._regrasps = 0
         self._rotations = 0
         self._terminal = False
+        self._togo_now = -1 if self._to_go is None else self._to_go(s)
         self._trail: list[tuple[int, tuple[int, ...]]] = [(self._k, self._c)]
         self._write_grasp()
         self._write_motion()
@@ -672,6 +730,10 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 self._h = lifted
                 self._regrasps += 1
                 self._write_grasp()
+                if self._to_go is not None:
+                    before, self._togo_now = self._togo_now, self._to_go(GaitState(k0, self._c))
+                    # both -1 when no gait exists from here: nothing gained
+                    self._gained = before - self._togo_now
             self._mask = self._compute_mask()
             self._write_motion()
             if self.render_mode is not None:
@@ -707,15 +769,24 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             return None
         if self._mask is None:
             raise self._reset_needed("render")
-        from graspgait_env.envs import render
-
-        args = (self.model, self._trail, self.config.turn_deg, self._regrasps)
         if self.render_mode == "rgb_array":
-            return render.render_frame(*args)
+            return self._frame()
         if self._renderer is None:
-            self._renderer = render.GaitRenderer(self.metadata["render_fps"])
-        self._renderer.show(*args)
+            from graspgait_env.envs.render import GaitRenderer
+
+            self._renderer = GaitRenderer(self.metadata["render_fps"])
+        self._renderer.show(self._frame)
         return None
+
+    def _frame(self) -> NDArray[np.uint8]:
+        """The present frame (see ``render_mode``), drawn by a
+        :class:`~graspgait_env.envs.render.GaitFrames` kept for the present model."""
+        frames = getattr(self, "_frames", None)
+        if frames is None or frames.model is not self.model:
+            from graspgait_env.envs.render import GaitFrames
+
+            frames = self._frames = GaitFrames(self.model)
+        return frames.frame(self._trail, self.config.turn_deg, self._regrasps)
 
     def close(self) -> None:
         """Close the human-mode window, if any (idempotent)."""
@@ -726,6 +797,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         d = self.__dict__.copy()
         d.pop("_win_view", None)  # views into _obs, rebuilt on unpickling
         d.pop("_mask_view", None)
+        d.pop("_line_view", None)
         return d
 
     def __setstate__(self, d: dict[str, Any]) -> None:
@@ -733,6 +805,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         C = self.config.map_window_cells
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
+        self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
 
 
 def _config_property(name: str) -> property:

@@ -134,14 +134,26 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
       :class:`~graspgait_env.envs.config.GraspGaitConfig` (``hand``, ``turn_deg``,
       ``n``, reward weights, ``max_backward_deg``, map window): as in ``GraspGait-v0``,
       checked the same way. ``mu`` is the planning friction (the controller's friction
-      cone check uses it); the contacts' true friction is ``sim_config.finger_mu``.
+      cone check uses it); the contacts' true friction is ``sim_config.finger_mu``
+      (default: ``mu`` itself). ``contact_model`` defaults to ``"hand"`` here (when no
+      ``config`` is given): the grasp maps, and so the action masks, are those of the
+      hand's rolling ball tips with the friction margin its rotations need
+      (:mod:`graspgait_env.contact_model`); ``"point"`` gives ``GraspGait-v0``'s maps.
     - ``sim_config``: :class:`~graspgait_env.sim.config.SimConfig`, a YAML path or None
       for ``configs/sim/default.yaml``.
     - ``pose_noise``: ``(max_offset_m, max_angle_deg)`` of the initial pose
       perturbation, or ``"thesis"`` for ``(0.006, 5.0)``.
-    - ``render_mode``: ``"rgb_array"``/``"human"`` draw the map-level frame of
-      ``GraspGait-v0`` (commanded state and gait so far), not a MuJoCo camera image:
-      it needs no GL context and costs the same as at map level.
+    - ``render_mode``: ``"rgb_array"`` returns a ``(480, 640, 3)`` uint8 frame of the
+      simulated hand seen from straight above (MuJoCo's off-screen renderer; headless
+      it needs ``MUJOCO_GL=egl``, which :mod:`graspgait_env.sim` sets when MuJoCo is
+      not yet imported), with the finger workspaces as coloured arcs (finger 1 red,
+      2 green, 3 blue), each fingertip in its finger's colour with its number beside
+      it, and captions: the object and friction, the commanded object angle with the
+      true one, and the move count (rotations, regrasps). ``"human"`` shows the same
+      frame in a matplotlib window (see ``GraspGait-v0``). One frame per move, so
+      ``metadata["render_fps"]`` (4) plays a recorded episode (Gymnasium's
+      ``RecordVideo``) at four moves per second. See
+      :class:`~graspgait_env.sim.view.HandView`.
 
     Attributes: ``executor`` (the :class:`GaitExecutor` of the present episode, None
     before the first reset) and ``physics`` (its by-name MuJoCo accessor).
@@ -169,6 +181,14 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         render_mode: str | None = None,
         **fields: Any,
     ) -> None:
+        if not (sim_config is None or isinstance(sim_config, (SimConfig, str, os.PathLike))):
+            raise GraspGaitInputError(
+                f"sim_config={sim_config!r}: give a SimConfig, a path to a sim YAML, or None "
+                "for configs/sim/default.yaml")
+        self.sim_config = (sim_config if isinstance(sim_config, SimConfig)
+                           else load_sim_config(sim_config))
+        if config is None and "contact_model" not in fields:
+            fields = {**fields, "contact_model": "hand"}  # plans the hand can execute
         super().__init__(object, mu, config=config, render_mode=render_mode, **fields)
         fix = "give (max_offset_m, max_angle_deg), e.g. (0.006, 5.0), or 'thesis' for that"
         if isinstance(pose_noise, str):
@@ -183,20 +203,20 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
                                         why="metres"),
                            check_number("pose_noise[1]", ang, 5.0, minimum=0.0,
                                         why="degrees"))
-        if not (sim_config is None or isinstance(sim_config, (SimConfig, str, os.PathLike))):
-            raise GraspGaitInputError(
-                f"sim_config={sim_config!r}: give a SimConfig, a path to a sim YAML, or None "
-                "for configs/sim/default.yaml")
-        self.sim_config = (sim_config if isinstance(sim_config, SimConfig)
-                           else load_sim_config(sim_config))
         # the executor loads the object's physical fields from its file when it has one
         self._sim_object: str | Shape = object if isinstance(object, str) else self.model.shape
         self.executor: GaitExecutor | None = None
         self._est_k: int | None = None  # estimated angle on the grid (None: use commanded)
         self._restricted = False
         self._replay: dict[str, Any] | None = None
+        self._hand_view = None  # sim.view.HandView, made by the first render()
+        self._resetting = False  # within the map-level reset (no frame to draw yet)
 
     # ------------------------------------------------------------------ simulation
+    def _planning_contact_model(self, object: str | os.PathLike | Shape):  # noqa: A002
+        """``config.contact_model`` for ``object``, the hand's from ``sim_config``."""
+        return self.config.planning_contact_model(object, self.sim_config)
+
     @property
     def physics(self):
         """The present episode's :class:`~graspgait_env.sim.model.HandPhysics` (or None)."""
@@ -265,7 +285,12 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         failures = []
         for attempt in range(1 if given else _START_TRIES):
             self._est_k = None
-            obs, info = super().reset(seed=seed if attempt == 0 else None, options=options)
+            self._resetting = True  # no human-mode frame until the hand holds the object
+            try:
+                obs, info = super().reset(seed=seed if attempt == 0 else None,
+                                          options=options)
+            finally:
+                self._resetting = False
             pert = (0.0, 0.0, 0.0)
             if self.pose_noise != (0.0, 0.0):
                 pert = random_pose_perturbation(self.np_random, *self.pose_noise)
@@ -290,6 +315,8 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         self._write_motion()
         info["action_mask"] = self._mask
         info.update(self._sim_info(report, None))
+        if self.render_mode == "human":
+            self.render()
         return self._obs.copy(), info
 
     def _sim_info(self, report: StepReport | None, warning: str | None) -> dict[str, Any]:
@@ -351,11 +378,50 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         info.update(self._sim_info(report, warning))
         if warning is None and report.status == "dropped":
             info["dropped"] = True
+        if self.render_mode == "human":
+            self.render()
         return self._obs.copy(), reward, True, False, info
+
+    # ------------------------------------------------------------------ rendering
+    def render(self) -> NDArray[np.uint8] | None:
+        """``rgb_array``: the hand now, ``(480, 640, 3)`` uint8; ``human``: show it (see
+        ``render_mode``). Called by the map-level ``reset`` before the hand holds the
+        object, it draws nothing (``reset`` shows the frame once the grasp is made)."""
+        if getattr(self, "_resetting", False):
+            return None
+        return super().render()
+
+    def _frame(self) -> NDArray[np.uint8]:
+        """The hand now, from above, with the overlays (see ``render_mode``)."""
+        from graspgait_env.sim.view import HandView
+
+        ex = self.executor
+        view = getattr(self, "_hand_view", None)
+        if view is None:
+            view = self._hand_view = HandView(ex.sim)
+        elif view.sim is not ex.sim:  # a new episode's model
+            view.use(ex.sim)
+        theta = self._k * self._step_deg
+        moves = self._rotations + self._regrasps
+        lines = [f"{self.model.shape.name}: plan mu={self.model.mu:g}, finger mu={ex.mu:g}",
+                 f"theta={theta:g} deg of {self.config.turn_deg:g} "
+                 f"(true {ex.theta_true:.1f})",
+                 f"moves {moves}: {self._rotations} rotations, {self._regrasps} regrasps"]
+        if ex.dropped:
+            lines.append("DROPPED")
+        return view.render(ex.physics, lines)
+
+    def close(self) -> None:
+        """Free the renderer's GL context and close the human-mode window (idempotent)."""
+        view, self._hand_view = getattr(self, "_hand_view", None), None
+        if view is not None:
+            view.close()
+        super().close()
 
     # ------------------------------------------------------------------ pickling
     def __getstate__(self) -> dict[str, Any]:
         d = super().__getstate__()
+        d.pop("_hand_view", None)  # a GL context does not pickle: the next render makes one
         ex = d.pop("executor", None)
         d["_fingerprint"] = None if ex is None else self._fingerprint()
         d["_disturbed"] = ex is not None and ex.disturbance_fn is not None

@@ -8,7 +8,7 @@ Gymnasium installed it does nothing (the map-level core needs only NumPy).
 
 from __future__ import annotations
 
-__all__ = ["ENV_IDS", "MAX_EPISODE_STEPS", "register_envs"]
+__all__ = ["ENV_IDS", "MAX_EPISODE_STEPS", "VECTOR_ENTRY_POINTS", "register_envs"]
 
 MAX_EPISODE_STEPS = 500  # (steps) time limit of every id; a thesis gait needs 20-40 moves
 
@@ -17,6 +17,12 @@ ENV_IDS: dict[str, str] = {
     "GraspGait-v0": "graspgait_env.envs.map_env:GraspGaitEnv",
     "GraspGaitRandom-v0": "graspgait_env.envs.random_env:GraspGaitRandomEnv",
     "GraspGaitMujoco-v0": "graspgait_env.envs.mujoco_env:GraspGaitMujocoEnv",
+}
+
+# id -> batched env: `gymnasium.make_vec(id, num_envs=N, vectorization_mode=
+# "vector_entry_point")` steps N copies in one NumPy call (other modes: "sync", "async")
+VECTOR_ENTRY_POINTS: dict[str, str] = {
+    "GraspGait-v0": "graspgait_env.envs.vector_env:GraspGaitVectorEnv",
 }
 
 
@@ -38,6 +44,7 @@ def register_envs() -> list[str]:
         if env_id in gymnasium.registry:
             continue
         gymnasium.register(id=env_id, entry_point=entry_point,
+                           vector_entry_point=VECTOR_ENTRY_POINTS.get(env_id),
                            max_episode_steps=MAX_EPISODE_STEPS)
         done.append(env_id)
     return done

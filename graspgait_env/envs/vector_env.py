@@ -1,0 +1,659 @@
+"""``GraspGait-v0`` batched: N map-level gait problems stepped in one NumPy call.
+
+``gymnasium.make_vec("graspgait_env:GraspGait-v0", num_envs=N,
+vectorization_mode="vector_entry_point")`` makes a :class:`GraspGaitVectorEnv`. Its
+transitions are those of ``N`` single ``gymnasium.make("graspgait_env:GraspGait-v0")``
+envs under Gymnasium's ``SyncVectorEnv`` (next-step autoreset), bit for bit: the same
+observations, rewards, ``terminated``/``truncated`` (the 500-step time limit included)
+and infos, for the same seeds. See the class docstring.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import MISSING, fields
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+from numpy.typing import NDArray
+
+from graspgait_env.envs.config import GraspGaitConfig, check_count
+from graspgait_env.envs.map_env import (
+    _HEADER,
+    _HELD,
+    _PHI,
+    _POS,
+    _THETA,
+    _TO_GO,
+    REWARD_TERMS,
+    GraspGaitEnv,
+    ResetNeededError,
+)
+from graspgait_env.envs.registration import MAX_EPISODE_STEPS
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.shapes import Shape
+
+__all__ = ["GraspGaitVectorEnv", "SUPPORTED_FIELDS", "sample_legal_actions"]
+
+# The config fields whose every value the batched step implements. A field added to
+# GraspGaitConfig later is accepted at its default (opt-in fields change nothing there)
+# and refused otherwise, naming the field (see GraspGaitVectorEnv.__init__).
+RUNS_TABLE_MAX = 1 << 24  # (bools) the contiguous regrasp-run table; n = 180 needs 1.5 M
+
+SUPPORTED_FIELDS: frozenset[str] = frozenset({
+    "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
+    "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
+    "map_window_deg", "map_window_cells", "map_lines", "contact_model",
+})
+
+
+class GraspGaitVectorEnv(gym.vector.VectorEnv):
+    r"""``num_envs`` copies of ``GraspGait-v0`` stepped together, as arrays.
+
+    ## Description
+
+    The map-level grasp-gait problem of :class:`~graspgait_env.envs.map_env.GraspGaitEnv`
+    (Leveroni, thesis ch. 4–6: rotations, thesis 5.2, and regrasps, thesis 4.2, until the
+    object has turned ``turn_deg``), for ``N`` independent episodes at once. One
+    :meth:`step` applies ``N`` moves, computes ``N`` legal-move masks (the rule of
+    :meth:`GaitModel.action_mask <graspgait_env.gait.GaitModel.action_mask>`, batched),
+    ``N`` observations and ``N`` rewards (the thesis path metric of 5.4 plus the
+    episode-end terms) with a fixed number of NumPy calls, whatever ``N``.
+
+    **Same transitions as N single envs.** With the same seeds, every array returned
+    equals what ``gymnasium.vector.SyncVectorEnv`` over ``N`` ``gymnasium.make(
+    "graspgait_env:GraspGait-v0", ...)`` envs returns (observations, rewards,
+    ``terminated``, ``truncated`` and every info key, with its ``_key`` mask); a test
+    compares them over random masked rollouts across autoresets. Each sub-env keeps its
+    own random generator: ``reset(seed=s)`` seeds sub-env ``i`` with ``s + i`` (a list
+    gives one seed each), and a sub-env restarted by autoreset draws its start grasp from
+    its own generator, as a single env does.
+
+    ## Action Space
+
+    ``MultiDiscrete([A] * N)``: one action per sub-env, as for ``GraspGait-v0``
+    (``single_action_space = Discrete(A)``, 182 with the thesis hand at ``n = 180``). An
+    illegal action leaves that sub-env's state unchanged and costs the ``illegal`` term.
+    ``actions`` must be an integer array (or sequence) of shape ``(N,)`` with every entry
+    in ``0 .. A-1`` (actions of sub-envs that autoreset at this step are checked too,
+    then ignored); anything else raises ``ValueError``
+    (:class:`~graspgait_env.errors.GraspGaitInputError`) naming it.
+
+    ## Observation Space
+
+    ``(N, 16 + A + C**2)`` float32: row ``i`` is sub-env ``i``'s ``GraspGait-v0``
+    observation (same layout, :class:`~graspgait_env.envs.map_env.ObservationLayout`).
+    A fresh array at every call (``copy=False`` returns the env's own buffer instead,
+    overwritten by the next call).
+
+    ## Rewards
+
+    Row by row those of ``GraspGait-v0`` (``alpha Δθ* / turn_scale_deg - beta [regrasp]
+    - gamma [rotation]`` plus ``success``, ``dead_end`` and ``illegal`` terms), summed in
+    the same order, so they are equal to the last bit; ``info["reward_terms"]`` holds
+    the six terms as arrays.
+
+    ## Starting State
+
+    Each sub-env draws its start with the single env's own code
+    (:meth:`GraspGaitEnv.reset <graspgait_env.envs.map_env.GraspGaitEnv.reset>`, on a
+    light copy of one template env per sub-env sharing its model and tables), so the
+    ``"start"`` option works as there and applies to every sub-env. ``reset(options=
+    {"reset_mask": m})`` (a bool array of shape ``(N,)``) resets only the sub-envs where
+    ``m`` is True, as ``SyncVectorEnv`` does.
+
+    ## Episode End
+
+    As ``GraspGait-v0`` (success, dead end, wrong way: ``terminated``), plus
+    ``truncated`` after ``max_episode_steps`` steps of an episode (500, the registered
+    time limit that ``gymnasium.make`` applies to the single env; None: no limit).
+    **Autoreset** is Gymnasium's next-step mode (``metadata["autoreset_mode"] =
+    AutoresetMode.NEXT_STEP``): the step after a sub-env's episode ends resets it, returns
+    its first observation with reward 0, ``terminated = truncated = False`` and its reset
+    info (``object``, ``mu`` keys, masked to the sub-envs that reset), and ignores its
+    action.
+
+    ## Infos
+
+    ``action_mask`` ``(N, A)`` bool (a fresh array each step; :meth:`action_masks`
+    returns the same), ``reward_terms`` (a dict of six ``(N,)`` float arrays),
+    ``is_success`` (bool), ``turn_deg`` (float), ``regrasps`` (int), each with its
+    ``_key`` mask, as ``SyncVectorEnv`` batches them.
+
+    ## Arguments
+
+    ``gymnasium.make_vec("graspgait_env:GraspGait-v0", num_envs=N,
+    vectorization_mode="vector_entry_point", object="ellipse", mu=0.7, config=None,
+    max_episode_steps=500, copy=True, **fields)``: the arguments of ``GraspGait-v0``
+    (``fields`` of :class:`~graspgait_env.envs.config.GraspGaitConfig`), checked with
+    the same messages, plus
+
+    - ``num_envs``: number of sub-envs (an integer >= 1).
+    - ``max_episode_steps``: the time limit (steps per episode; None: none).
+    - ``copy``: return fresh observation arrays (default) or the env's buffer.
+
+    Every field of today's config is implemented: ``map_lines`` adds the map lines to
+    each row, ``contact_model`` changes the shared gait model, ``to_go_weight`` looks up
+    the optimum's regrasps to go of each sub-env that regrasps, one at a time (this
+    opt-in reward slows the batched step). A field added to the config later
+    (:data:`SUPPORTED_FIELDS` does not list it) is accepted at its default and raises
+    ``ValueError`` naming it otherwise. ``render_mode`` must be None: the batched env
+    draws nothing (make a single env with ``render_mode="rgb_array"`` to watch one
+    episode).
+
+    ## Version History
+
+    - v0: initial version.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": [],
+                                          "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        object: str | os.PathLike | Shape = "ellipse",  # noqa: A002 - the user-facing name
+        mu: float = 0.7,
+        *,
+        config: GraspGaitConfig | None = None,
+        max_episode_steps: int | None = MAX_EPISODE_STEPS,
+        render_mode: str | None = None,
+        copy: bool = True,
+        **fields_: Any,
+    ) -> None:
+        N = check_count("num_envs", num_envs, 1, 16)
+        if max_episode_steps is not None:
+            max_episode_steps = check_count("max_episode_steps", max_episode_steps, 1,
+                                            MAX_EPISODE_STEPS)
+        if render_mode is not None:
+            raise GraspGaitInputError(
+                f"render_mode={render_mode!r}: the batched GraspGait env draws nothing; give "
+                "None, or watch one episode with gymnasium.make(\"graspgait_env:GraspGait-v0\", "
+                "render_mode=\"rgb_array\")")
+        if not isinstance(copy, (bool, np.bool_)):
+            raise GraspGaitInputError(f"copy={copy!r}: must be True or False")
+        # The template: one single env checks the arguments (same messages) and holds
+        # the per-model tables that the batched step reads (one definition of each).
+        env = GraspGaitEnv(object, mu, config=config, **fields_)
+        _check_supported(env.config)
+        self.template = env
+        self.config = env.config
+        self.model = env.model
+        self.layout = env.layout
+        self.num_envs = N
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = None
+        self.copy = bool(copy)
+        self.single_observation_space = env.observation_space
+        self.single_action_space = env.action_space
+        self.observation_space = batch_space(env.observation_space, N)
+        self.action_space = batch_space(env.action_space, N)
+
+        # per-sub-env reset: light copies of the template (shared model and tables, own
+        # random generator), so starts are drawn by the single env's own code
+        starts = env.model.start_states()
+        env._starts = starts
+        self._subs: list[GraspGaitEnv] = []
+        for _ in range(N):
+            sub = _copy_env(env)
+            self._subs.append(sub)
+
+        m = env.model
+        self._A = A = int(m.n_actions)
+        self._R = int(m.R)
+        self._P = int(m.P)
+        self._n = int(m.n)
+        self._ws_start = np.asarray(m.ws_start, dtype=np.int64)
+        self._ws_width = np.asarray(m.ws_width, dtype=np.int64)
+        # the extended grasp map, transposed, as a view of every run of P contacts:
+        # runs[c, i] = "contact c against contacts i .. i+P-1", GaitModel.action_mask's
+        # regrasp rule (thesis 4.2), gathered for a batch of states in one call
+        rows = np.ascontiguousarray(m.grasp_map.extended().T)
+        self._runs = np.lib.stride_tricks.sliding_window_view(rows, self._P, axis=1)
+        # the same runs for c, i < n as one contiguous (n n, P) table, where it is small:
+        # a row gather from it (np.take) is several times faster than from the view
+        n2P = self._n * self._n * self._P
+        self._runs_table = (np.ascontiguousarray(self._runs[:self._n, :self._n]).reshape(
+            self._n * self._n, self._P) if n2P <= RUNS_TABLE_MAX else None)
+        self._valid = np.arange(self._P) < self._ws_width[:, None]  # (3, P): inside W_h
+        self._rotation_tables(m)
+        # a regrasp with free finger h and lift l (thesis 4.2, GaitModel.decode): row 2h + l
+        # gives the finger lifted (the lower held one for l = 0) and the new held pair f < g
+        lifted, new_f, new_g = [], [], []
+        for h in range(3):
+            held = [x for x in range(3) if x != h]
+            for lift in (0, 1):
+                kept = held[1 - lift]
+                lifted.append(held[lift])
+                new_f.append(min(h, kept))
+                new_g.append(max(h, kept))
+        self._regrasp_lifted, self._regrasp_f, self._regrasp_g = (
+            np.array(x, dtype=np.int64) for x in (lifted, new_f, new_g))
+        self._arN = np.arange(N)
+        self._row3 = 3 * self._arN  # flat offsets of rows in (N, 3) arrays
+        self._rowA = A * self._arN  # ... and in (N, A) arrays
+        self._delta = np.asarray(env._delta, dtype=np.int64)  # rotation delta per action
+        # (cos, sin) of grid angle i at row i (the object angle theta = k mod n), and of
+        # contact c at row c + 1 of _phi_cs, whose row 0 (a free finger, c = -1) is 0, 0
+        self._theta_cs = np.column_stack([env._cos, env._sin]).astype(np.float64)
+        self._phi_cs = np.vstack([np.zeros(2), self._theta_cs])
+        self._all = np.ones(N, dtype=bool)  # the "_key" mask of keys every sub-env has
+        self._all.flags.writeable = False
+        self._inv_w = np.asarray(env._inv_w, dtype=np.float64)
+        self._sign, self._Kabs, self._back = env._sign, env._Kabs, env._back
+        self._turn_coef = env._turn_coef
+        self._step_deg = env._step_deg
+        self._k_tables()
+        self._win_back = env._win_back
+        self._windows = _window_views(env._pooled, env._stride, self.config.map_window_cells)
+        # map_lines: the grasp map's rows tiled twice, every run of n as a view, so that a
+        # held contact's line at angle k is row c, column (-k) mod n (the single env's rule)
+        self._lines = (None if env._line_src is None else
+                       np.lib.stride_tricks.sliding_window_view(env._line_src, self._n, axis=1))
+        # to_go_weight: the exact optimum's regrasps to go (the single env's table; looked
+        # up one regrasp at a time, so this opt-in reward costs speed)
+        self._to_go = env._to_go
+        self._togo_now = np.full(N, -1, dtype=np.int64)
+
+        # batched state: object angle k, contacts c (-1: free), workspace positions p
+        # (-1: free), held fingers f < g and free finger h, mask, counters
+        self._k = np.zeros(N, dtype=np.int64)
+        self._c = np.full((N, 3), -1, dtype=np.int64)
+        self._p = np.full((N, 3), -1, dtype=np.int64)
+        self._f = np.zeros(N, dtype=np.int64)
+        self._g = np.ones(N, dtype=np.int64)
+        self._h = np.full(N, 2, dtype=np.int64)
+        self._mask = np.zeros((N, A), dtype=bool)
+        self._regrasps = np.zeros(N, dtype=np.int64)
+        self._elapsed = np.zeros(N, dtype=np.int64)
+        self._autoreset = np.zeros(N, dtype=bool)
+        self._obs = np.zeros((N, self.layout.size), dtype=np.float32)
+        # the observation's header (held, positions, contacts, theta, turn), built here
+        # column by column and written into the observation rows in one assignment
+        self._head = np.zeros((N, _HEADER), dtype=np.float32)
+        self._started = False
+
+    def _rotation_tables(self, model: Any) -> None:
+        """The rotation block of the mask (its first ``2R`` entries) from a table.
+
+        ``GaitModel.rotation_room`` (thesis 5.2, the one definition) gives the room
+        ``(ccw, cw)`` of fingers ``f < g`` at workspace positions ``(p_f, p_g)``;
+        ``_rot_index[f, g, p_f, p_g] = ccw (R + 1) + cw`` and row ``ccw (R + 1) + cw`` of
+        ``_rot_rows`` sets the first ``ccw`` counter-clockwise and ``cw`` clockwise
+        entries.
+        """
+        R, P = self._R, self._P
+        ar = np.arange(R)
+        room = np.arange(R + 1)
+        ccw, cw = np.meshgrid(room, room, indexing="ij")
+        self._rot_rows = np.concatenate([ar < ccw.reshape(-1, 1), ar < cw.reshape(-1, 1)],
+                                        axis=1)
+        self._rot_index = np.zeros((3, 3, P, P), dtype=np.int64)
+        pf, pg = np.meshgrid(np.arange(P), np.arange(P), indexing="ij")
+        for f, g in ((0, 1), (0, 2), (1, 2)):
+            inside = (pf < self._ws_width[f]) & (pg < self._ws_width[g])
+            a, b = model.rotation_room(f, np.where(inside, pf, 0), g, np.where(inside, pg, 0))
+            self._rot_index[f, g] = np.where(inside, a * (R + 1) + b, 0)
+
+    def _k_tables(self) -> None:
+        """What depends on the object angle ``k`` alone, per ``k``: the observation's
+        ``cos θ, sin θ``, turn achieved and turn to go (as the single env writes them),
+        ``min(σk, |K|)`` (the turn term's θ*, thesis 5.4), success and the wrong-way end.
+
+        An episode ends once ``σk >= |K|`` or ``σk < -B``, and one move turns at most
+        ``R`` steps, so ``k`` stays within ``|K| + B + R`` of 0; the tables span that.
+        """
+        sign, K, R, n = self._sign, self._Kabs, self._R, self._n
+        span = K + self._back + R + 1
+        self._k_lo = -span
+        k = np.arange(-span, span + 1, dtype=np.int64)
+        t = sign * k
+        head = np.empty((k.size, 4), dtype=np.float32)
+        head[:, :2] = self._theta_cs[k % n]
+        head[:, 2] = t / K
+        head[:, 3] = np.maximum(0, K - t) / K
+        self._k_head = head
+        self._k_reached = np.minimum(t, K)  # θ* in grid steps
+        self._k_success = t >= K
+        self._k_ends = self._k_success | (t < -self._back)
+
+    # ------------------------------------------------------------------ state
+    def action_masks(self) -> NDArray[np.bool_]:
+        """Legal actions of every sub-env, ``(N, A)`` bool (sb3-contrib MaskablePPO
+        protocol); row ``i`` is ``model.action_mask`` of sub-env ``i``'s state. A fresh
+        array.
+
+        Raises
+        ------
+        ResetNeededError
+            Before the first ``reset()``.
+        """
+        self._need_reset("action_masks")
+        return self._mask.copy()
+
+    def states(self) -> list[Any]:
+        """Each sub-env's :class:`~graspgait_env.gait.GaitState` ``(k, contacts)``."""
+        from graspgait_env.gait import GaitState
+
+        self._need_reset("states")
+        return [GaitState(int(k), tuple(int(x) for x in c))
+                for k, c in zip(self._k, self._c, strict=True)]
+
+    def _need_reset(self, what: str) -> None:
+        if not self._started:
+            raise ResetNeededError(f"{what}: call reset() first (no episode has started, "
+                                   "or the last reset() raised)")
+
+    # ------------------------------------------------------------------ reset
+    def _reset_subs(self, idx: Sequence[int], seeds: Sequence[int | None],
+                    options: Mapping[str, Any] | None, infos: dict[str, Any]) -> None:
+        """Reset sub-envs ``idx`` with the single env's ``reset`` and load their states."""
+        for i, seed in zip(idx, seeds, strict=True):
+            sub = self._subs[i]
+            obs, info = sub.reset(seed=seed, options=options)
+            s = sub.state
+            self._obs[i] = obs
+            self._head[i] = obs[:_HEADER]
+            self._mask[i] = info["action_mask"]
+            self._k[i] = s.k
+            self._c[i] = s.contacts
+            infos = self._add_info(infos, info, i)
+        idx = np.asarray(idx, dtype=np.int64)
+        c = self._c[idx]
+        h = np.argmin(c, axis=1)  # the free finger: the one contact that is -1
+        self._h[idx] = h
+        self._f[idx] = (h == 0).astype(np.int64)  # held fingers, ascending
+        self._g[idx] = np.where(h == 2, 1, 2)
+        # workspace positions (GaitModel.position): p = (c + k - ws_start) mod n
+        p = (c + self._k[idx, None] - self._ws_start) % self._n
+        self._p[idx] = np.where(c >= 0, p, -1)
+        self._regrasps[idx] = 0
+        if self._to_go is not None:
+            for i in idx.tolist():
+                self._togo_now[i] = self._to_go(self._subs[i].state)
+        self._elapsed[idx] = 0
+        self._autoreset[idx] = False
+
+    def reset(self, *, seed: int | Sequence[int | None] | None = None,
+              options: dict[str, Any] | None = None) -> tuple[NDArray[np.float32], dict]:
+        """Reset every sub-env (or those of ``options["reset_mask"]``).
+
+        Parameters
+        ----------
+        seed
+            None (fresh entropy for sub-envs without a generator), an integer ``s``
+            (sub-env ``i`` gets ``s + i``) or a list of ``N`` seeds (None entries allowed).
+        options
+            ``{"start": ...}`` as for ``GraspGait-v0`` (every sub-env) and/or
+            ``{"reset_mask": m}``, a bool array of shape ``(N,)``.
+
+        Returns
+        -------
+        obs, info
+            ``(N, obs_size)`` float32 and the batched reset infos.
+        """
+        N = self.num_envs
+        if seed is None:
+            seeds: list[int | None] = [None] * N
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+            seeds = [int(seed) + i for i in range(N)]
+        elif isinstance(seed, Sequence) and not isinstance(seed, str) and len(seed) == N:
+            seeds = list(seed)
+        else:
+            raise GraspGaitInputError(
+                f"seed={seed!r}: give None, an integer >= 0 (sub-env i gets seed + i) or a "
+                f"list of {N} seeds")
+        opts = dict(options) if options is not None else None
+        if opts is not None and "reset_mask" in opts:
+            m = opts.pop("reset_mask")
+            if not (isinstance(m, np.ndarray) and m.dtype == np.bool_ and m.shape == (N,)
+                    and m.any()):
+                raise GraspGaitInputError(
+                    f"options['reset_mask']={m!r}: must be a NumPy bool array of shape "
+                    f"({N},) with at least one True")
+            idx = np.flatnonzero(m).tolist()
+        else:
+            idx = list(range(N))
+            self._started = False  # until every sub-env has reset
+        infos: dict[str, Any] = {}
+        self._reset_subs(idx, [seeds[i] for i in idx], opts or None, infos)
+        self._started = True
+        return (self._obs.copy() if self.copy else self._obs), infos
+
+    # ------------------------------------------------------------------ step
+    def _check_actions(self, actions: Any) -> NDArray[np.int64]:
+        a = np.asarray(actions)
+        N, A = self.num_envs, self._A
+        if a.shape != (N,) or a.dtype.kind not in "iu":
+            raise GraspGaitInputError(
+                f"actions={actions!r}: must be an integer array of shape ({N},), one action "
+                f"index in 0..{A - 1} per sub-env, e.g. env.action_space.sample("
+                "mask=tuple(env.action_masks()))" if a.shape != (N,) or a.dtype.kind != "b"
+                else f"actions={actions!r}: bools are not action indices; give an integer "
+                f"array of shape ({N},)")
+        if a.dtype != np.int64:
+            a = a.astype(np.int64)
+        if N and (a.min() < 0 or a.max() >= A):
+            i = int(np.flatnonzero((a < 0) | (a >= A))[0])
+            raise GraspGaitInputError(
+                f"actions[{i}]={int(a[i])}: outside the action space 0..{A - 1}")
+        return a
+
+    def _compute_masks(self) -> None:
+        """``model.action_mask`` of every sub-env's state, in one batch (thesis 5.2).
+
+        Rotations: the room left on the tighter side each way, ``ccw = min(W_f - 1 - p_f,
+        W_g - 1 - p_g)``, ``cw = min(p_f, p_g)`` (``GaitModel.rotation_room``). Regrasps
+        (thesis 4.2): the free finger ``h`` at every position of its workspace, object
+        contact ``(s_h + p - k) mod n``, against the kept contact, read from the
+        transposed extended grasp map; the two lifts interleaved (lower finger first).
+        """
+        R, n, row3 = self._R, self._n, self._row3
+        f, g, h = self._f, self._g, self._h
+        p, c = self._p.ravel(), self._c.ravel()
+        mask = self._mask
+        room = self._rot_index[f, g, p.take(row3 + f), p.take(row3 + g)]
+        mask[:, :2 * R] = self._rot_rows.take(room, axis=0)
+        i0 = (self._ws_start.take(h) - self._k) % n
+        valid, b = self._valid.take(h, axis=0), 2 * R
+        cg, cf = c.take(row3 + g), c.take(row3 + f)
+        if self._runs_table is not None:
+            run_g = self._runs_table.take(cg * n + i0, axis=0)
+            run_f = self._runs_table.take(cf * n + i0, axis=0)
+        else:
+            run_g, run_f = self._runs[cg, i0], self._runs[cf, i0]
+        # interleaved: keep g (lift f, l = 0) at even slots, keep f (lift g, l = 1) at odd
+        np.logical_and(run_g, valid, out=mask[:, b::2])
+        np.logical_and(run_f, valid, out=mask[:, b + 1::2])
+
+    def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
+        """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
+        as the single env counts it (-1 to -1, no gait before or after: 0)."""
+        from graspgait_env.gait import GaitState
+
+        before = self._togo_now[idx]
+        now = np.array([self._to_go(GaitState(int(k), tuple(int(x) for x in c)))
+                        for k, c in zip(self._k[idx], self._c[idx], strict=True)],
+                       dtype=np.int64)
+        self._togo_now[idx] = now
+        return before - now
+
+    def _write_window(self, idx: NDArray[np.int64]) -> None:
+        """Grasp-map window rows of sub-envs ``idx`` (their grasp changed): the single
+        env's ``pooled[i0 : i0 + sC : s, j0 : j0 + sC : s]``, gathered as blocks."""
+        n, c, at = self._n, self._c.ravel(), 3 * idx
+        i0 = (c.take(at + self._f.take(idx)) - self._win_back) % n
+        j0 = (c.take(at + self._g.take(idx)) - self._win_back) % n
+        s = self._windows.shape[0]
+        win = self._windows[i0 % s, j0 % s, i0 // s, j0 // s]
+        self._obs[idx, self.layout.window] = win.reshape(idx.size, -1)
+
+    def step(self, actions: Any) -> tuple[NDArray[np.float32], NDArray[np.float64],
+                                          NDArray[np.bool_], NDArray[np.bool_], dict]:
+        """One move in every sub-env (see the class docstring); returns
+        ``(obs, rewards, terminated, truncated, info)``, each batched over sub-envs."""
+        self._need_reset("step")
+        a = self._check_actions(actions)
+        N, R, n = self.num_envs, self._R, self._n
+        infos: dict[str, Any] = {}
+        reset_idx = np.flatnonzero(self._autoreset)
+        live = ~self._autoreset
+        legal = self._mask.ravel().take(self._rowA + a) & live
+        d = self._delta[a]
+        rot = legal & (d != 0)
+        rg = legal & (d == 0)
+        # rotations (thesis 5.2): both contacts move d grid steps through their workspaces
+        dk = np.where(rot, d, 0)
+        self._k += dk
+        self._p += dk[:, None] * (self._c >= 0)
+        # regrasps (thesis 4.2): the free finger h to position p, the lifted finger freed
+        ri = np.flatnonzero(rg)
+        if ri.size:
+            q = a[ri] - 2 * R
+            pos = q >> 1
+            h = self._h[ri]
+            move = 2 * h + (q & 1)  # (free finger, lift l): the new fingers from a table
+            lifted = self._regrasp_lifted[move]
+            self._c[ri, h] = (self._ws_start[h] + pos - self._k[ri]) % n
+            self._c[ri, lifted] = -1
+            self._p[ri, h] = pos
+            self._p[ri, lifted] = -1
+            self._f[ri] = self._regrasp_f[move]
+            self._g[ri] = self._regrasp_g[move]
+            self._h[ri] = lifted
+            self._regrasps += rg
+        # sub-envs whose last episode ended restart here (next-step autoreset)
+        if reset_idx.size:
+            self._reset_subs(reset_idx.tolist(), [None] * reset_idx.size, None, infos)
+        self._compute_masks()
+        mask = self._mask
+        # observation (the GraspGait-v0 table), every row
+        o, hd, c, p, k = self._obs, self._head, self._c, self._p, self._k
+        if ri.size:
+            cr = c[ri]
+            hd[ri, _HELD:_HELD + 3] = cr >= 0
+            hd[ri, _PHI:_PHI + 6] = self._phi_cs.take(cr + 1, axis=0).reshape(ri.size, 6)
+            self._write_window(ri)
+        hd[:, _POS:_POS + 3] = np.where(p >= 0, p * self._inv_w, -1.0)
+        ki = k - self._k_lo  # rows of the per-k tables
+        hd[:, _THETA:_TO_GO + 1] = self._k_head.take(ki, axis=0)
+        o[:, :_HEADER] = hd
+        o[:, self.layout.mask] = mask
+        if self._lines is not None:  # thesis 4.3: the regrasps keeping f or g
+            shift = -k % n
+            lines = o[:, self.layout.lines].reshape(N, 2, n)
+            lines[:, 0] = self._lines[c[self._arN, self._f], shift]
+            lines[:, 1] = self._lines[c[self._arN, self._g], shift]
+        # episode ends and reward (GraspGaitEnv._reward's table, term by term, same order)
+        is_success = self._k_success[ki]
+        terminated = live & (self._k_ends[ki] | ~mask.any(axis=1))
+        cfg = self.config
+        reached = self._k_reached
+        turn = self._turn_coef * (reached[ki] - reached[ki - dk])  # thesis 5.4
+        if reset_idx.size:
+            turn[reset_idx] = 0.0  # a restarted sub-env earns nothing at this step
+        regrasp = np.where(rg, -cfg.beta, 0.0)  # thesis 5.4: - beta per regrasp
+        if self._to_go is not None and ri.size:  # + to_go_weight * regrasps gained
+            regrasp[ri] += cfg.to_go_weight * self._regrasps_gained(ri)
+        rotation = np.where(rot, -cfg.gamma, 0.0)  # thesis 5.4: - gamma per rotation
+        success = np.where(terminated & is_success, cfg.success_bonus, 0.0)
+        dead_end = np.where(terminated & ~is_success, -cfg.dead_end_penalty, 0.0)
+        illegal = np.where(live & ~legal, -cfg.illegal_penalty, 0.0)
+        reward = turn + regrasp + rotation + success + dead_end + illegal
+        # the time limit (gymnasium's TimeLimit: truncated once elapsed >= the limit)
+        self._elapsed += live
+        if self.max_episode_steps is None:
+            truncated = np.zeros(N, dtype=bool)
+        else:
+            truncated = live & (self._elapsed >= self.max_episode_steps)
+        self._autoreset = terminated | truncated
+        # infos, batched as SyncVectorEnv batches the single env's (the reset sub-envs'
+        # keys were written above)
+        # ("_key" masks are shared and read-only)
+        on = self._all
+        live.flags.writeable = False
+        infos["action_mask"], infos["_action_mask"] = mask.copy(), on
+        if reset_idx.size < N:  # the step's keys, where a sub-env stepped (not restarted)
+            terms = (turn, regrasp, rotation, success, dead_end, illegal)
+            rt: dict[str, Any] = {}
+            for key, v in zip(REWARD_TERMS, terms, strict=True):
+                rt[key], rt["_" + key] = v, live
+            infos["reward_terms"], infos["_reward_terms"] = rt, live
+        infos["is_success"], infos["_is_success"] = is_success, on
+        infos["turn_deg"], infos["_turn_deg"] = k * self._step_deg, on
+        infos["regrasps"], infos["_regrasps"] = self._regrasps.copy(), on
+        obs = o.copy() if self.copy else o
+        return obs, reward, terminated, truncated, infos
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Nothing to release (no renderer, no processes)."""
+
+
+def sample_legal_actions(masks: NDArray[np.bool_], u: NDArray[np.floating]) -> NDArray[np.int64]:
+    """One action per row, uniform over that row's legal actions (a masked random policy).
+
+    Parameters
+    ----------
+    masks
+        ``(N, A)`` bool legal-move masks (``info["action_mask"]``).
+    u
+        ``(N,)`` uniforms in ``[0, 1)`` (e.g. ``rng.random(N)``): row ``i`` takes its
+        ``floor(u_i * L_i)``-th legal action (``L_i`` legal actions), in index order. A
+        row without a legal action (a dead end, restarted by the next step) gets
+        ``A - 1``.
+
+    Returns
+    -------
+    ndarray of int64, shape (N,)
+    """
+    N, A = masks.shape
+    # legal actions counted through the flattened batch: row i's j-th legal action is
+    # where the running count first exceeds (count before row i) + j
+    count = np.cumsum(masks.ravel(), dtype=np.int32)  # int32: NumPy's fast path
+    ends = count[A - 1::A]  # the running count at each row's end
+    before = np.concatenate(([0], ends[:-1]))
+    pick = before + (u * (ends - before)).astype(np.int32)
+    found = np.searchsorted(count, pick, side="right") - A * np.arange(N)
+    return np.minimum(found, A - 1)
+
+
+def _copy_env(env: GraspGaitEnv) -> GraspGaitEnv:
+    """A light copy of ``env``: shares its model, tables and start list; no generator
+    yet (the first ``reset`` seeds it, as a fresh single env's does)."""
+    sub = copy.copy(env)
+    sub._np_random = None
+    sub._np_random_seed = None
+    return sub
+
+
+def _window_views(pooled: NDArray[np.float32], s: int, cells: int) -> NDArray[np.float32]:
+    """Every grasp-map window as a read-only view ``V[ri, rj, qi, qj]`` of shape
+    ``(s, s, ., ., cells, cells)``: the window whose origin is ``(s qi + ri, s qj + rj)``
+    in the tiled pooled map, i.e. ``pooled[i0 : i0 + s cells : s, j0 : j0 + s cells : s]``
+    with ``i0 = s qi + ri``. The map is regrouped by stride phase (a copy of its size),
+    so that each window is a contiguous-stride block and a batch of windows is one
+    fancy-indexed gather of blocks."""
+    L = -(-pooled.shape[0] // s) * s
+    padded = np.zeros((L, L), dtype=pooled.dtype)
+    padded[:pooled.shape[0], :pooled.shape[1]] = pooled
+    phases = np.ascontiguousarray(padded.reshape(L // s, s, L // s, s).transpose(1, 3, 0, 2))
+    return np.lib.stride_tricks.sliding_window_view(phases, (cells, cells), axis=(2, 3))
+
+
+def _check_supported(cfg: GraspGaitConfig) -> None:
+    """Refuse config fields the batched step does not implement (set off their default)."""
+    for fld in fields(cfg):
+        if fld.name in SUPPORTED_FIELDS:
+            continue
+        value = getattr(cfg, fld.name)
+        default = fld.default_factory() if fld.default is MISSING else fld.default
+        if value != default:
+            raise GraspGaitInputError(
+                f"{fld.name}={value!r}: the batched GraspGait env (vectorization_mode="
+                f"\"vector_entry_point\") implements only the default {default!r}; leave "
+                f"{fld.name} at its default, or use vectorization_mode=\"sync\"")

@@ -1,0 +1,227 @@
+"""The batched GraspGait-v0 (``vectorization_mode="vector_entry_point"``).
+
+Its transitions must equal those of N single envs (Gymnasium's ``SyncVectorEnv`` over
+``gymnasium.make``) bit for bit, across autoresets, for the same seeds.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import graspgait_env  # noqa: F401  (registers the ids)
+from graspgait_env.envs import vector_env
+from graspgait_env.envs.map_env import REWARD_TERMS, ResetNeededError
+from graspgait_env.envs.vector_env import GraspGaitVectorEnv
+from graspgait_env.errors import GraspGaitInputError
+
+ID = "graspgait_env:GraspGait-v0"
+
+
+def _batched(num_envs: int, **kw) -> gym.vector.VectorEnv:
+    return gym.make_vec(ID, num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
+
+
+def _sync(num_envs: int, **kw) -> gym.vector.VectorEnv:
+    return gym.make_vec(ID, num_envs=num_envs, vectorization_mode="sync", **kw)
+
+
+def assert_same(x, y, path="") -> None:
+    """Equal values, types, dtypes and shapes, recursively (dicts of arrays)."""
+    if isinstance(x, tuple):
+        assert isinstance(y, tuple) and len(x) == len(y), path
+        for i, (u, v) in enumerate(zip(x, y, strict=True)):
+            assert_same(u, v, f"{path}[{i}]")
+        return
+    if isinstance(x, dict):
+        assert isinstance(y, dict) and set(x) == set(y), (path, sorted(x), sorted(y))
+        for key in x:
+            assert_same(x[key], y[key], f"{path}/{key}")
+        return
+    assert type(x) is type(y), (path, type(x), type(y))
+    if isinstance(x, np.ndarray):
+        assert (x.dtype, x.shape) == (y.dtype, y.shape), (path, x.dtype, y.dtype, x.shape,
+                                                          y.shape)
+        np.testing.assert_array_equal(x, y, err_msg=path)
+    else:
+        assert x == y, path
+
+
+def masked_actions(masks: np.ndarray, rng: np.random.Generator,
+                   illegal_rate: float = 0.1) -> np.ndarray:
+    """A uniform legal action per row; with probability ``illegal_rate`` a step of
+    uniform actions over the whole space (illegal moves included)."""
+    if rng.random() < illegal_rate:
+        return rng.integers(0, masks.shape[1], masks.shape[0])
+    counts = masks.sum(axis=1)
+    pick = (rng.random(masks.shape[0]) * counts).astype(np.int64)
+    return np.array([np.flatnonzero(m)[j] for m, j in zip(masks, pick, strict=True)])
+
+
+def compare_rollouts(num_envs: int, seed: int, steps: int, **kw) -> dict[str, int]:
+    """Step the batched and the sync env side by side; return counts of episode ends."""
+    a, b = _batched(num_envs, **kw), _sync(num_envs, **kw)
+    obs_a, info_a = a.reset(seed=seed)
+    obs_b, info_b = b.reset(seed=seed)
+    assert_same(obs_a, obs_b)
+    assert_same(info_a, info_b)
+    rng = np.random.default_rng(seed)
+    ends = {"success": 0, "other_end": 0, "truncated": 0}
+    for t in range(steps):
+        act = masked_actions(info_a["action_mask"], rng)
+        out_a, out_b = a.step(act), b.step(act)
+        for name, x, y in zip(("obs", "reward", "terminated", "truncated", "info"),
+                              out_a, out_b, strict=True):
+            assert_same(x, y, f"step {t} {name}")
+        info_a = out_a[4]
+        term, trunc = out_a[2], out_a[3]
+        ends["success"] += int((term & info_a["is_success"]).sum())
+        ends["other_end"] += int((term & ~info_a["is_success"]).sum())
+        ends["truncated"] += int(trunc.sum())
+    a.close()
+    b.close()
+    return ends
+
+
+@pytest.mark.parametrize("n, seed", [(1, 0), (3, 1), (16, 2)])
+def test_same_transitions_as_single_envs(n, seed):
+    """Episodes end often (a 20-degree turn, a 10-degree wrong-way limit): successes,
+    wrong-way ends and restarts in every run."""
+    ends = compare_rollouts(n, seed, 200, object="ellipse", turn_deg=20.0,
+                            max_backward_deg=10.0)
+    assert ends["success"] > 0 and ends["other_end"] > 0
+
+
+def test_same_transitions_at_the_registered_time_limit():
+    """Default config: masked random play rarely finishes, so the 500-step limit truncates."""
+    ends = compare_rollouts(2, 7, 1100)
+    assert ends["truncated"] >= 2
+
+
+@pytest.mark.parametrize("kw", [
+    {"object": "pentagon", "mu": 0.5, "turn_deg": -60.0, "max_episode_steps": 40},
+    {"beta": 0.2, "gamma": 0.0, "alpha": -1.0, "turn_scale_deg": 45.0, "success_bonus": 3.0,
+     "illegal_penalty": 0.5, "map_window_cells": 9, "map_window_deg": 90.0, "turn_deg": 30.0},
+    {"n": 90, "hand": "thesis", "map_window_cells": 30, "turn_deg": 40.0},
+    {"map_lines": True, "turn_deg": 40.0},
+    {"to_go_weight": 0.5, "turn_deg": 60.0},
+    {"contact_model": "hand", "object": "pentagon", "turn_deg": 40.0},
+])
+def test_same_transitions_with_config_fields(kw):
+    compare_rollouts(3, 11, 100, **kw)
+
+
+def test_reset_mask_and_start_option_match_sync():
+    a, b = _batched(3), _sync(3)
+    start = {"start": {1: 50.0, 3: 270.0}}
+    assert_same(a.reset(seed=4, options=start), b.reset(seed=4, options=start))
+    rng = np.random.default_rng(0)
+    info = a.reset(seed=[5, None, 6])[1]
+    b.reset(seed=[5, 6, 7])
+    b.reset(seed=[5, None, 6])  # sub-env 1 keeps its generator, as in the batched env
+    for _ in range(5):
+        act = masked_actions(info["action_mask"], rng, 0.0)
+        out = a.step(act)
+        b.step(act)
+        info = out[4]
+    m = np.array([False, True, True])
+    ra = a.reset(seed=9, options={"reset_mask": m})
+    rb = b.reset(seed=9, options={"reset_mask": m})
+    assert_same(ra[1], rb[1])
+    np.testing.assert_array_equal(ra[0][m], rb[0][m])
+
+
+def test_masks_are_the_gait_models():
+    env = _batched(8, object="pentagon").unwrapped
+    _, info = env.reset(seed=3)
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        masks = env.action_masks()
+        np.testing.assert_array_equal(masks, info["action_mask"])
+        for s, m in zip(env.states(), masks, strict=True):
+            np.testing.assert_array_equal(m, env.model.action_mask(s))
+        info = env.step(masked_actions(masks, rng))[4]
+
+
+def test_rewards_are_their_terms_summed():
+    env = _batched(6, turn_deg=20.0)
+    _, info = env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        _, r, *_, info = env.step(masked_actions(info["action_mask"], rng))
+        terms = info["reward_terms"]
+        total = sum(terms[k] for k in REWARD_TERMS)
+        np.testing.assert_array_equal(r[terms["_turn"]], total[terms["_turn"]])
+
+
+def test_default_vectorization_is_the_batched_env():
+    env = gym.make_vec(ID, num_envs=2)
+    assert isinstance(env.unwrapped, GraspGaitVectorEnv)
+    assert env.metadata["autoreset_mode"] is gym.vector.AutoresetMode.NEXT_STEP
+    assert env.observation_space.shape == (2, env.single_observation_space.shape[0])
+
+
+def test_bad_inputs_name_the_argument():
+    with pytest.raises(GraspGaitInputError, match="num_envs=0"):
+        GraspGaitVectorEnv(0)
+    with pytest.raises(GraspGaitInputError, match="mu='abc'"):
+        _batched(2, mu="abc")
+    with pytest.raises(GraspGaitInputError, match="bta"):
+        _batched(2, bta=0.1)
+    with pytest.raises(GraspGaitInputError, match="render_mode='rgb_array'"):
+        GraspGaitVectorEnv(2, render_mode="rgb_array")
+    env = GraspGaitVectorEnv(2)
+    with pytest.raises(ResetNeededError):
+        env.step(np.zeros(2, dtype=np.int64))
+    env.reset(seed=0)
+    with pytest.raises(GraspGaitInputError, match=r"shape \(2,\)"):
+        env.step(np.zeros(3, dtype=np.int64))
+    with pytest.raises(GraspGaitInputError, match="integer"):
+        env.step(np.zeros(2))
+    with pytest.raises(GraspGaitInputError, match="bools"):
+        env.step(np.ones(2, dtype=bool))
+    with pytest.raises(GraspGaitInputError, match=r"actions\[1\]=182"):
+        env.step(np.array([0, 182]))
+    with pytest.raises(GraspGaitInputError, match="reset_mask"):
+        env.reset(options={"reset_mask": np.zeros(2, dtype=bool)})
+    with pytest.raises(GraspGaitInputError, match="seed="):
+        env.reset(seed=[1, 2, 3])
+    with pytest.raises(GraspGaitInputError, match="options\\['strat'\\]"):
+        env.reset(options={"strat": {}})
+
+
+def test_an_unimplemented_config_field_is_refused_by_name(monkeypatch):
+    """A field added to GraspGaitConfig after the batched env: accepted at its default,
+    refused (named) away from it. Simulated by withdrawing ``beta`` from the list."""
+    monkeypatch.setattr(vector_env, "SUPPORTED_FIELDS", vector_env.SUPPORTED_FIELDS - {"beta"})
+    GraspGaitVectorEnv(2, beta=0.01)
+    with pytest.raises(GraspGaitInputError, match=r"beta=0\.05: the batched GraspGait env"):
+        GraspGaitVectorEnv(2, beta=0.05)
+
+
+def test_new_config_fields_are_listed_or_refused():
+    """Every config field is either implemented or refused away from its default."""
+    from dataclasses import fields
+
+    from graspgait_env.envs.config import GraspGaitConfig
+
+    for f in fields(GraspGaitConfig):
+        if f.name in vector_env.SUPPORTED_FIELDS:
+            continue
+        value = 0.5 if isinstance(f.default, (int, float)) else "point-x"
+        try:
+            GraspGaitConfig(**{f.name: value})
+        except GraspGaitInputError:
+            continue  # not a valid value: nothing to refuse
+        with pytest.raises(GraspGaitInputError, match=f.name):
+            GraspGaitVectorEnv(1, **{f.name: value})
+
+
+def test_large_grids_read_the_regrasp_runs_from_the_view(monkeypatch):
+    """Above RUNS_TABLE_MAX (large n) the masks gather from the strided view instead of
+    the contiguous table: the same transitions."""
+    monkeypatch.setattr(vector_env, "RUNS_TABLE_MAX", 0)
+    env = GraspGaitVectorEnv(2)
+    assert env._runs_table is None
+    compare_rollouts(3, 5, 60, turn_deg=20.0)
