@@ -31,6 +31,11 @@ demo: $(STAMP)
 		--json out/pentagon_plan.json --motion out/pentagon_motion.txt --png out/pentagon_gait.png
 	$(BIN)/graspgait plan pentagon --mu 0.7 --planner rule \
 		--json out/pentagon_rule_plan.json --png out/pentagon_rule_gait.png
+	@echo "==> the ellipse's story, no training: the rule-based, optimal and learned gaits from one"
+	@echo "    start, on the grasp map with a comparison table (shipped agent agents/models/ellipse.zip)"
+	$(BIN)/graspgait story ellipse --out out
+	@echo "==> the learned gait executed on the simulated MuJoCo hand, with a video"
+	$(BIN)/graspgait simulate out/ellipse_learned_plan.json --video out/ellipse_learned.mp4
 	@echo
 	@echo "demo: made these files in $(CURDIR)/out:"
 	@ls -1 out | sed 's/^/  out\//'

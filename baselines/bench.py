@@ -22,6 +22,7 @@ import math
 import statistics
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 from tqdm.auto import tqdm
@@ -31,10 +32,13 @@ from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.planners.registry import get_planner
 from graspgait_env.timing import BenchRow, register
 
-__all__ = ["BenchCase", "bench_starts", "run_bench", "markdown_report", "THESIS_TABLE_1",
-           "THESIS_TABLE_6_1", "THESIS_OBJECTS"]
+__all__ = ["BenchCase", "bench_starts", "run_bench", "run_case", "DEFAULT_PLANNERS",
+           "markdown_report", "THESIS_TABLE_1", "THESIS_TABLE_6_1", "THESIS_OBJECTS"]
 
 THESIS_OBJECTS = ("circle", "ellipse", "pentagon", "hexagon")  # thesis fig. 5.3 (a)-(d)
+# the bench's planners, in column order: best-first with both tie-breaks (5.5), the
+# rule-based method (6.5), the modified search alone (6.4), the exact optimum
+DEFAULT_PLANNERS = ("best-first", "best-first-newest", "rule", "modified", "optimal")
 # Table 1 (best-first): (nodes opened, path length, regrasps) per object and mu.
 THESIS_TABLE_1: dict[tuple[str, float], tuple[float, float, float]] = {
     ("circle", 0.8): (500.2, 44.8, 22.4), ("circle", 0.7): (957.7, 82.0, 41.1),
@@ -64,6 +68,9 @@ class BenchCase:
     rotation_deg: float
     wall_time_s: float
     pattern: str
+    method: str = ""
+    entry_needed: bool | None = None
+    entry_moves: int | None = None
 
 
 def bench_starts(model: GaitModel, count: int = 10) -> list[GaitState]:
@@ -85,28 +92,68 @@ def bench_starts(model: GaitModel, count: int = 10) -> list[GaitState]:
     return picked
 
 
-def run_bench(objects=THESIS_OBJECTS, mus=(0.8, 0.7), planners=("best-first", "rule", "optimal"),
+@lru_cache(maxsize=16)
+def _model(obj: str, mu: float) -> GaitModel:
+    """The bench's gait model: the thesis's point contacts, the default hand, n = 180."""
+    return GaitModel(obj, mu)
+
+
+def run_case(obj: str, mu: float, start: GaitState, planner: str, turn_deg: float = 360.0,
+             planner_kwargs: dict[str, Any] | None = None) -> BenchCase:
+    """One run of the bench: ``planner`` from ``start`` on object ``obj`` at ``mu``.
+
+    A plain function of its arguments (the model is rebuilt, or cached, in the process
+    that runs it), so runs can be farmed out to other processes.
+
+    Parameters
+    ----------
+    obj
+        Object name or YAML path.
+    mu
+        Friction coefficient.
+    start
+        Start grasp at θ = 0 (a legal state of ``GaitModel(obj, mu)``).
+    planner
+        A planner name of :data:`~graspgait_env.planners.registry.PLANNERS`.
+    turn_deg
+        Requested turn (degrees).
+    planner_kwargs
+        Extra keyword arguments of the planner.
+
+    Returns
+    -------
+    BenchCase
+        The run's row; ``method``, ``entry_needed`` and ``entry_moves`` come from the
+        rule-based planners' ``extra`` (empty / ``None`` for the others).
+    """
+    model = _model(obj, mu)
+    fn = get_planner(planner)
+    t0 = time.perf_counter()
+    r = fn(model, start, turn_deg, **(planner_kwargs or {}))
+    wall = time.perf_counter() - t0
+    label = ",".join(f"{f + 1}:{model.contact_deg(start.contacts[f]):g}" for f in start.held())
+    return BenchCase(obj, mu, label, planner, r.success, r.nodes_opened, r.path_length,
+                     r.regrasps, r.rotation_deg, wall, r.pattern,
+                     str(r.extra.get("method", "")), r.extra.get("entry_needed"),
+                     r.extra.get("entry_moves"))
+
+
+def run_bench(objects=THESIS_OBJECTS, mus=(0.8, 0.7), planners=DEFAULT_PLANNERS,
               starts: int = 10, turn_deg: float = 360.0, progress: bool = True,
               planner_kwargs: dict[str, dict[str, Any]] | None = None) -> list[BenchCase]:
-    """Run every planner from the same starts on every object and μ; one row per run."""
-    fns = {p: get_planner(p) for p in planners}
+    """Run every planner from the same starts on every object and μ; one row per run
+    (:func:`run_case` per run)."""
+    for p in planners:
+        get_planner(p)  # refuse unknown names before any work
     kw = planner_kwargs or {}
     jobs = []
     for obj in objects:
         for mu in mus:
-            model = GaitModel(obj, mu)
-            for s in bench_starts(model, starts):
+            for s in bench_starts(_model(obj, mu), starts):
                 for p in planners:
-                    jobs.append((obj, mu, model, s, p))
-    cases = []
-    for obj, mu, model, s, p in tqdm(jobs, desc="bench", disable=not progress, unit="run"):
-        t0 = time.perf_counter()
-        r = fns[p](model, s, turn_deg, **kw.get(p, {}))
-        wall = time.perf_counter() - t0
-        label = ",".join(f"{f + 1}:{model.contact_deg(s.contacts[f]):g}" for f in s.held())
-        cases.append(BenchCase(obj, mu, label, p, r.success, r.nodes_opened, r.path_length,
-                               r.regrasps, r.rotation_deg, wall, r.pattern))
-    return cases
+                    jobs.append((obj, mu, s, p))
+    return [run_case(obj, mu, s, p, turn_deg, kw.get(p))
+            for obj, mu, s, p in tqdm(jobs, desc="bench", disable=not progress, unit="run")]
 
 
 def _mean(xs: list[float]) -> float:
@@ -127,6 +174,9 @@ def summarize(cases: list[BenchCase]) -> dict[tuple[str, float, str], dict[str, 
             "nodes_opened": _mean([c.nodes_opened for c in ok]),
             "path_length": _mean([c.path_length for c in ok]),
             "regrasps": _mean([c.regrasps for c in ok]),
+            "nodes_per_step": (_mean([c.nodes_opened for c in ok])
+                               / _mean([c.path_length for c in ok])) if ok and any(
+                                   c.path_length for c in ok) else math.nan,
             "success": len(ok) / len(runs),
             "wall_ms": 1e3 * _mean([c.wall_time_s for c in runs]),
             "runs": len(runs),
@@ -139,44 +189,64 @@ def _f(x: float) -> str:
 
 
 def markdown_report(cases: list[BenchCase]) -> str:
-    """Tables 1 and 6.1 regenerated, with the thesis's figures beside ours."""
+    """Tables 1 and 6.1 regenerated, with the thesis's figures beside ours, and how the
+    rule-based method ran from each start."""
     summ = summarize(cases)
-    planners = sorted({c.planner for c in cases}, key=lambda p: ("best-first", "rule",
-                                                                "optimal").index(p)
-                      if p in ("best-first", "rule", "optimal") else 9)
+    order = list(DEFAULT_PLANNERS)
+    planners = sorted({c.planner for c in cases},
+                      key=lambda p: (order.index(p) if p in order else len(order), p))
     objs = [o for o in THESIS_OBJECTS if any(c.object == o for c in cases)] + sorted(
         {c.object for c in cases} - set(THESIS_OBJECTS))
     mus = sorted({c.mu for c in cases}, reverse=True)
+    rows = (("nodes opened", "nodes_opened"), ("path length", "path_length"),
+            ("regrasps", "regrasps"), ("nodes per path step", "nodes_per_step"),
+            ("success rate", "success"), ("wall time (ms)", "wall_ms"))
     lines = ["### Table 1 regenerated: best-first search (thesis 5.5) and the other planners",
              "", "| object | mu | data | thesis best-first | " + " | ".join(planners) + " |",
              "|---|---|---|---:|" + "---:|" * len(planners)]
     for o in objs:
         for mu in mus:
             th = THESIS_TABLE_1.get((o, mu))
-            for j, (name, key) in enumerate((("nodes opened", "nodes_opened"),
-                                             ("path length", "path_length"),
-                                             ("regrasps", "regrasps"),
-                                             ("success rate", "success"),
-                                             ("wall time (ms)", "wall_ms"))):
+            for j, (name, key) in enumerate(rows):
                 ref = _f(th[j]) if th and j < 3 else ""
+                if key == "nodes_per_step" and th:
+                    ref = f"{th[0] / th[1]:,.2f}"
                 vals = [summ.get((o, mu, p), {}).get(key, math.nan) for p in planners]
-                fmt = [f"{v:.0%}" if key == "success" and not math.isnan(v) else _f(v)
-                       for v in vals]
+                fmt = [f"{v:.0%}" if key == "success" and not math.isnan(v)
+                       else f"{v:,.2f}" if key == "nodes_per_step" and not math.isnan(v)
+                       else _f(v) for v in vals]
                 lines.append(f"| {o} | {mu:g} | {name} | {ref} | " + " | ".join(fmt) + " |")
+    cols = [p for p in planners if p != "modified"]
     if 0.7 in mus:
         lines += ["", "### Table 6.1 regenerated (mu = 0.7): general (best-first) vs rule-based",
-                  "", "| object | data | thesis general | thesis rule-based | best-first | rule "
-                  "| optimal |", "|---|---|---:|---:|---:|---:|---:|"]
+                  "", "| object | data | thesis general | thesis rule-based | "
+                  + " | ".join(cols) + " |", "|---|---|---:|---:|" + "---:|" * len(cols)]
         for o in objs:
             th = THESIS_TABLE_1.get((o, 0.7))
-            for j, (name, key) in enumerate((("nodes opened", "nodes_opened"),
-                                             ("path length", "path_length"),
-                                             ("regrasps", "regrasps"))):
-                ours = [_f(summ.get((o, 0.7, p), {}).get(key, math.nan))
-                        for p in ("best-first", "rule", "optimal")]
+            for j, (name, key) in enumerate(rows[:3]):
+                ours = [_f(summ.get((o, 0.7, p), {}).get(key, math.nan)) for p in cols]
                 lines.append(f"| {o} | {name} | {_f(th[j]) if th else ''} | "
                              f"{_f(THESIS_TABLE_6_1.get(o, math.nan))} | " + " | ".join(ours)
                              + " |")
+    rule = [c for c in cases if c.planner == "rule"]
+    if rule:
+        lines += ["", "### The rule-based method, start by start", "",
+                  "| object | mu | starts | forward | back-and-forth | modified search | "
+                  "box entered (moves) | patterns |", "|---|---|---:|---:|---:|---:|---|---|"]
+        for o in objs:
+            for mu in mus:
+                runs = [c for c in rule if (c.object, c.mu) == (o, mu)]
+                if not runs:
+                    continue
+                by = {m: sum(c.method == m for c in runs if c.success)
+                      for m in ("forward", "back-and-forth", "modified-search")}
+                entries = [c.entry_moves for c in runs if c.entry_needed]
+                entered = (f"{len(entries)} ({', '.join(map(str, entries))})" if entries
+                           else "0")
+                pats = sorted({c.pattern for c in runs if c.pattern})
+                lines.append(f"| {o} | {mu:g} | {len(runs)} | {by['forward']} | "
+                             f"{by['back-and-forth']} | {by['modified-search']} | {entered} | "
+                             f"{', '.join(pats)} |")
     return "\n".join(lines)
 
 
@@ -234,6 +304,13 @@ def bench_planners(repeat: int) -> list[BenchRow]:
         rows.append(BenchRow(f"exact planner, {obj}", sec, "s", f"<= {EXACT_TARGET_S:g} s",
                              r.success and sec <= EXACT_TARGET_S,
                              f"mu=0.7, n=180, {r.regrasps} regrasps"))
+        t0 = time.perf_counter()
+        r = exact(model, None, 360.0)  # the object's optimum: every start seeded at once
+        sec = time.perf_counter() - t0
+        rows.append(BenchRow(f"exact planner, every start, {obj}", sec, "s",
+                             f"<= {EXACT_TARGET_S:g} s", r.success and sec <= EXACT_TARGET_S,
+                             f"mu=0.7, n=180, {r.extra.get('starts_seeded', 0)} starts, "
+                             f"{r.regrasps} regrasps"))
         opened = [best(model, st, 360.0).nodes_opened for st in starts]
         th = THESIS_TABLE_1[(obj, 0.7)][0]
         rows.append(BenchRow(f"best-first nodes opened, {obj}", _mean(opened), "nodes", "",

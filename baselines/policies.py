@@ -124,7 +124,7 @@ def rebased_model(model: GaitModel, k: int) -> GaitModel:
     ws = tuple(((lo - shift) % 360.0, (lo - shift) % 360.0 + (hi - lo))
                for lo, hi in model.hand.workspaces_deg)
     m = GaitModel(model.shape, model.mu, Hand(ws, f"{model.hand.name} turned {-shift:g} deg"),
-                  model.n, max_radius=model.max_radius)
+                  model.n, max_radius=model.max_radius, contact_model=model.contact_model)
     ok = (m.ws_width.tolist() == model.ws_width.tolist()
           and all((int(m.ws_start[f]) - int(model.ws_start[f]) + k) % model.n == 0
                   for f in range(3)))

@@ -280,7 +280,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         raise GraspGaitInputError(f"--n {n}: planning takes at most {MAX_PLAN_N} grid points "
                                   f"(a {360 / MAX_PLAN_N:g}-degree grid; about 3 GB at n=1800); "
                                   "give e.g. 180")
-    model = GaitModel(args.object, mu, hand=args.hand, n=n, vertex_clearance_deg=clearance)
+    contact_model = _plan_contact_model(args)
+    model = GaitModel(args.object, mu, hand=args.hand, n=n, vertex_clearance_deg=clearance,
+                      contact_model=contact_model)
     try:
         model.turn_steps(args.turn)  # refuses a turn beyond what the planners can hold
     except GraspGaitInputError as exc:
@@ -288,6 +290,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     start = _parse_start(args.start, model)
     res = run_planner(args.planner, model, start, args.turn)
     print(model.shape.describe())
+    print(_describe_contact_model(contact_model))
     print(f"planner {res.planner}: nodes opened {res.nodes_opened}, created "
           f"{res.nodes_created}, wall time {res.wall_time_s * 1000:.1f} ms")
     if res.plan is None:
@@ -313,9 +316,13 @@ def _cmd_plan(args: argparse.Namespace) -> int:
                            "path_length": res.path_length})
     if res.pattern:
         res.plan.stats["pattern"] = res.pattern
+    res.plan.contact_model = contact_model.to_json()  # what the hand must match
     print(f"gait: {res.regrasps} regrasps, path length {res.path_length}, rotation "
           f"{res.rotation_deg:g} deg" + (f", pattern {res.pattern}" if res.pattern else ""))
     print(f"start {res.plan.steps[0]['contacts']}; plan passes the validator")
+    if res.extra.get("start_chosen"):  # optimal without --start: the object's optimum
+        print(f"start chosen by the planner: the fewest regrasps over all "
+              f"{res.extra['starts_seeded']} legal start grasps at theta = 0")
     if args.json:
         _write_output("--json", args.json, lambda: res.plan.save(args.json))
         print(f"wrote {args.json}")
@@ -334,6 +341,33 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         _write_output("--png", args.png, lambda: save_figure(fig, args.png))
         print(f"wrote {args.png}")
     return 0
+
+
+def _plan_contact_model(args: argparse.Namespace):
+    """The contact model ``graspgait plan`` plans for: the hand's (ball tips, a friction
+    margin for the rotations' load; graspgait_env.contact_model), derived from the
+    simulation config, unless ``--point-contacts`` (the thesis's maps)."""
+    from graspgait_env.contact_model import POINT_CONTACTS, hand_contact_model
+    from graspgait_env.objects import load_object
+    from graspgait_env.workspace import load_hand
+
+    if args.point_contacts:
+        if args.sim_config is not None:
+            raise GraspGaitInputError("--sim-config with --point-contacts: point contacts "
+                                      "assume no hand; drop one of them")
+        return POINT_CONTACTS
+    hand, _ = load_hand(args.hand, load_object(args.object))
+    return hand_contact_model(args.object, args.sim_config,
+                              workspaces_deg=hand.workspaces_deg, turn_deg=args.turn)
+
+
+def _describe_contact_model(cm) -> str:
+    """One line naming the contact model a plan assumes."""
+    if cm.is_point:
+        return "contact model: point contacts (the thesis's idealized maps)"
+    return (f"contact model: hand: ball tips {1e3 * cm.tip_radius_m:.1f} mm, contacts "
+            f"{1e3 * cm.vertex_clearance_m:.1f} mm clear of vertices, friction margin for a "
+            f"{cm.load_torque_nm:.4f} N m rotation load at {cm.grip_n:g} N grip")
 
 
 def _add_plan(sub: argparse._SubParsersAction) -> None:
@@ -357,9 +391,16 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                    "of 360/n deg (default 180)")
     p.add_argument("--hand", default=None, help=_hand_help())
     p.add_argument("--vertex-clearance", type=float, default=0.0, metavar="DEG",
-                   help="keep contacts DEG degrees off polygon vertices (default 0, the "
-                   "thesis's point contacts; 4 for plans run by `graspgait simulate`: a ball "
-                   "tip rolls off corners)")
+                   help="also keep contacts DEG degrees off polygon vertices (default 0: "
+                   "only what the contact model needs)")
+    p.add_argument("--point-contacts", action="store_true",
+                   help="plan for the thesis's idealized point contacts (the maps of "
+                   "Tables 1 and 6.1) instead of the simulated hand's ball tips; "
+                   "`graspgait simulate` warns about such plans")
+    p.add_argument("--sim-config", metavar="SIM.yaml", default=None,
+                   help="the simulation config whose hand the plan is for (default "
+                   "configs/sim/default.yaml): tip radius, table friction, rotation "
+                   "acceleration and grip set the contact model")
     p.add_argument("--verbose", action="store_true",
                    help="when no gait exists, print the planner's account and the whole "
                    "diagnosis (grasp map, prototype conditions, each start tried) instead "
@@ -373,6 +414,14 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
 # --- bench ----------------------------------------------------------------------------
 
 
+def _add_ray_option(p: argparse.ArgumentParser, what: str) -> None:
+    """``--ray [ADDRESS]``: ``args.ray`` is None (no Ray), ``"local"`` (a local Ray
+    started here) or the cluster's address."""
+    p.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
+                   help=f"{what}: on the Ray cluster at ADDRESS (auto, HOST:6379, "
+                   "ray://HOST:10001), or without ADDRESS on a local Ray started here")
+
+
 def _csv_list(flag: str, text: str, conv):
     try:
         vals = [conv(v) for v in text.split(",") if v.strip()]
@@ -381,6 +430,23 @@ def _csv_list(flag: str, text: str, conv):
     if not vals:
         raise GraspGaitInputError(f"{flag} {text!r}: give a comma-separated list")
     return vals
+
+
+def _bench_cases(args: argparse.Namespace, objects: list[str], mus: list[float],
+                 planners: list[str]) -> list:
+    """The bench's cases, serially or (``--ray``) one Ray task per object and mu; a failed
+    cell is reported on stderr (the exit status becomes 1) and the others kept."""
+    from baselines import bench
+
+    if args.ray is None:
+        return bench.run_bench(objects, mus, planners, args.starts)
+    from baselines.scale_out import bench_on_ray
+
+    cases, failures = bench_on_ray(objects, mus, planners, args.starts, address=args.ray)
+    for f in failures:
+        _error(f"bench cell {f.label} failed on Ray: {f.error}")
+    args.failed_cells = len(failures)
+    return cases
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -399,8 +465,11 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
     for o in objects:
         load_object(o)  # refuse bad names before the long run
-    cases = bench.run_bench(objects, mus, planners, args.starts)
-    report = bench.markdown_report(cases)
+    _check_outputs(args, {"png": _figure_suffixes()})
+    agents = _bench_agents(args.agents)  # agents.bench; loaded before the long run
+    cases = _bench_cases(args, objects, mus, planners)
+    cases, agents_report = agents(cases, objects, mus, args.starts)
+    report = bench.markdown_report(cases) + agents_report
     print(report)
     if args.csv:
         _write_output("--csv", args.csv, lambda: bench.write_csv(cases, args.csv))
@@ -413,7 +482,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
         _write_output("--md", args.md, lambda: write_text_atomic(args.md, report + "\n"))
         print(f"wrote {args.md}")
-    return 0
+    if args.png:
+        from agents.bench import plot_bench
+
+        _write_output("--png", args.png, lambda: plot_bench(cases, args.png))
+        print(f"wrote {args.png}")
+    return 1 if getattr(args, "failed_cells", 0) else 0
 
 
 def _add_bench(sub: argparse._SubParsersAction) -> None:
@@ -424,13 +498,35 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--objects", default="circle,ellipse,pentagon,hexagon",
                    help="comma-separated objects (default the thesis's four)")
     p.add_argument("--mus", default="0.8,0.7", help="comma-separated friction coefficients")
-    p.add_argument("--planners", default="best-first,rule,optimal",
-                   help="comma-separated planner names")
+    p.add_argument("--planners", default="best-first,best-first-newest,rule,modified,optimal",
+                   help="comma-separated planner names (default: best-first with ties to the "
+                   "oldest and to the newest node, rule, modified, optimal)")
     p.add_argument("--starts", type=int, default=10, help="initial grasps per object and mu")
+    _add_ray_option(p, "run one Ray task per object and mu; same tables as the serial bench")
     p.add_argument("--csv", metavar="FILE", help="write one row per run")
     p.add_argument("--json", metavar="FILE", help="write runs and summary")
     p.add_argument("--md", metavar="FILE", help="write the Markdown tables")
+    p.add_argument("--agents", default="shipped", metavar="shipped|none|NAME,...",
+                   help="learned agents to run from the same starts: the shipped models "
+                   "present in agents/models/ (default), none, or names / .zip paths")
+    p.add_argument("--png", metavar="FILE", help="plot regrasps per 360 deg of every method")
     p.set_defaults(func=_cmd_bench)
+
+
+def _bench_agents(spec: str) -> Callable[..., tuple[list, str]]:
+    """The agents' part of ``graspgait bench`` (agents.bench): ``run(cases, objects, mus,
+    starts) -> (cases + the agents' runs, their Markdown section)``."""
+    from agents.bench import agents_markdown, find_agents, run_agent_bench
+
+    agents, notes = find_agents(spec)
+
+    def run(cases: list, objects: list[str], mus: list[float], starts: int) -> tuple[list, str]:
+        if not agents and not notes:
+            return cases, ""
+        cases = cases + run_agent_bench(agents, objects, mus, starts)
+        return cases, "\n\n" + agents_markdown(cases, notes)
+
+    return run
 
 
 # --- simulate -------------------------------------------------------------------------
@@ -441,8 +537,46 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from graspgait_env.sim.simulate import simulate_command
 
     _check_outputs(args, {"json": (".json",)})  # --video: simulate_command checks it
+    if args.seeds is not None or args.ray is not None:
+        return _simulate_campaign(args)
     return simulate_command(args.plan, video=args.video, seed=args.seed, perturb=args.perturb,
                             config=args.config, json_out=args.json, progress=not args.quiet)
+
+
+def _simulate_campaign(args: argparse.Namespace) -> int:
+    """``--seeds``/``--ray``: the perturbed campaign (thesis 7.5), one run per seed, each
+    from a random initial pose error drawn from its seed; a table and the tally; exit 0
+    when every run succeeds, 1 otherwise (a failed run is reported, the others kept)."""
+    import json
+
+    from baselines.scale_out import campaign, parse_seeds, summarize_campaign
+    from graspgait_env.plan import Plan
+
+    if args.video is not None or args.perturb not in (None, "random"):
+        raise GraspGaitInputError(
+            f"--seeds/--ray with --video/--perturb {args.perturb or ''}: the campaign draws a "
+            "random pose error per seed and records no video; drop them")
+    seeds = parse_seeds(args.seeds) if args.seeds is not None else [args.seed]
+    plan = Plan.load(args.plan)
+    from graspgait_env.sim.simulate import point_contact_warning
+
+    warning = point_contact_warning(plan, args.plan)
+    if warning:
+        print(f"{PROG}: warning: {warning}", file=sys.stderr)
+    results, failures = campaign(plan, seeds, args.config, address=args.ray,
+                                 use_ray=args.ray is not None, progress=not args.quiet)
+    print(summarize_campaign(results, seeds))
+    for f in failures:
+        _error(f"simulate {f.label} failed: {f.error}")
+    if args.json:
+        from graspgait_env.atomic import write_text_atomic
+
+        doc = [{"seed": s, **(r or {"status": "failed"})} for s, r in zip(seeds, results,
+                                                                          strict=True)]
+        text = json.dumps(doc, indent=1, default=float) + "\n"
+        _write_output("--json", args.json, lambda: write_text_atomic(args.json, text))
+        print(f"wrote {args.json}")
+    return 0 if all(r is not None and r["success"] for r in results) else 1
 
 
 def _add_simulate(sub: argparse._SubParsersAction) -> None:
@@ -459,10 +593,187 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:
                    help="initial object pose error: metres, metres, degrees; or 'random' "
                    "(up to 6 mm and 5 deg, from --seed)")
     p.add_argument("--seed", type=int, default=0, help="seed for --perturb random")
+    p.add_argument("--seeds", metavar="SEEDS", help="the perturbed campaign: one run per seed "
+                   "(e.g. 0-9), each from a random pose error drawn from it; a table and tally")
+    _add_ray_option(p, "run the campaign's runs as Ray tasks; same results")
     p.add_argument("--config", metavar="SIM.yaml", help="simulation config "
                    "(default configs/sim/default.yaml)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_simulate)
+
+
+# --- train ----------------------------------------------------------------------------
+
+
+def _cmd_train(args: argparse.Namespace) -> int:
+    from agents.config import load_train_config
+    from agents.train import train
+
+    config = load_train_config(args.config, args.set or [])
+    if args.seeds is not None or args.ray is not None:
+        return _train_seeds(args, config)
+    result = train(config, run_dir=args.run_dir, resume=args.resume, progress=not args.quiet)
+    ev = result.last_eval
+
+    def pct(x: float | None) -> str:
+        return "-" if x is None else f"{x:.1%}"
+
+    vs = ev.get("regrasps_vs_optimal")
+    print(f"trained {result.steps} steps in {result.wall_s:.0f} s; final evaluation: success "
+          f"{pct(ev.get('success_rate'))} ({pct(ev.get('success_rate_solvable'))} of the starts "
+          f"with a gait), regrasps x{'-' if vs is None else f'{vs:.3f}'} the optimum")
+    print(f"wrote {result.model_path} (card {result.model_path.with_suffix('.json')}); "
+          f"TensorBoard: tensorboard --logdir {result.run_dir / 'tb'}")
+    return 0
+
+
+def _train_seeds(args: argparse.Namespace, config) -> int:
+    """``--seeds`` / ``--ray``: one run per seed (Ray Tune trials with ``--ray``); a table
+    of the final evaluations; exit 1 when a seed failed (the others are kept)."""
+    from agents.ray_train import train_seeds
+    from baselines.scale_out import parse_seeds
+
+    if args.resume is not None or args.run_dir is not None:
+        raise GraspGaitInputError("--seeds/--ray with --resume/--run-dir: each seed gets its "
+                                  "own run folder; resume one run at a time without --seeds")
+    seeds = parse_seeds(args.seeds) if args.seeds is not None else [config.seed]
+    outcomes = train_seeds(config, seeds, use_ray=args.ray is not None, address=args.ray,
+                           progress=not args.quiet)
+    print("| seed | steps | success | success (solvable) | regrasps vs optimum | run |")
+    print("|---:|---:|---:|---:|---:|---|")
+    for o in outcomes:
+        if o.error is not None:
+            _error(f"seed {o.seed} failed: {o.error}")
+            continue
+        ev = o.last_eval or {}
+        cells = [ev.get("success_rate"), ev.get("success_rate_solvable")]
+        pct = ["-" if x is None else f"{x:.1%}" for x in cells]
+        vs = ev.get("regrasps_vs_optimal")
+        print(f"| {o.seed} | {o.steps} | {pct[0]} | {pct[1]} | "
+              f"{'-' if vs is None else f'{vs:.3f}'} | {o.run_dir} |")
+    return 1 if any(o.error is not None for o in outcomes) else 0
+
+
+def _add_train(sub: argparse._SubParsersAction) -> None:
+    from graspgait_env.resources import bundled_names
+
+    p = sub.add_parser("train", help="train a PPO / MaskablePPO agent from a YAML config",
+                       description="Train an agent on a GraspGait env: progress bar, TensorBoard "
+                       "logs, periodic evaluation against the exact optimum and the rule-based "
+                       "gait, checkpoints; the run's folder is runs/{env}-{config}-s{seed}-{time}"
+                       " and the model is saved there as model.zip with its card model.json.")
+    p.add_argument("config", metavar="CONFIG", help="a bundled training config "
+                   f"({', '.join(bundled_names('train'))}) or a YAML path")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="replace a config field (YAML value; dots reach into env_kwargs, e.g. "
+                   "env_kwargs.mu=0.8); repeatable")
+    p.add_argument("--resume", metavar="CHECKPOINT",
+                   help="continue from a checkpoint zip (RUN/checkpoints/model_N_steps.zip)")
+    p.add_argument("--run-dir", metavar="DIR", help="the run's folder (default "
+                   "RUN_ROOT/{env}-{config}-s{seed}-{time}; with --resume, the checkpoint's run)")
+    p.add_argument("--seeds", metavar="SEEDS", help="one run per seed, e.g. 0-9 or 0,3,5 "
+                   "(each in its own run folder; a table of the final evaluations)")
+    _add_ray_option(p, "run the seeds as Ray Tune trials, one per seed")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_train)
+
+
+# --- evaluate -------------------------------------------------------------------------
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from agents.config import apply_overrides
+    from agents.evaluate import evaluate, format_evaluation, write_evaluation
+
+    _check_outputs(args, {"json": (".json",)})
+    mu = None if args.mu is None else _check_mu(args.mu)
+    if args.episodes < 1:
+        raise GraspGaitInputError(f"--episodes {args.episodes}: must be >= 1, e.g. 100")
+    if args.seed < 0:
+        raise GraspGaitInputError(f"--seed {args.seed}: must be >= 0, e.g. 0")
+    env_set = apply_overrides({"env_kwargs": {}},
+                              [f"env_kwargs.{s}" for s in args.set or []])["env_kwargs"]
+    if args.ray is not None:
+        from agents.ray_train import evaluate_on_ray
+
+        result = evaluate_on_ray(args.model, env_id=args.env, object=args.object, mu=mu,
+                                 episodes=args.episodes, seed=args.seed, env_overrides=env_set,
+                                 address=args.ray, progress=not args.quiet)
+    else:
+        result = evaluate(args.model, env_id=args.env, object=args.object, mu=mu,
+                          episodes=args.episodes, seed=args.seed, env_overrides=env_set,
+                          progress=not args.quiet)
+    print(format_evaluation(result))
+    if args.json:
+        _write_output("--json", args.json, lambda: write_evaluation(result, args.json))
+        print(f"wrote {args.json}")
+    return 0
+
+
+def _add_evaluate(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("evaluate", help="evaluate a trained agent against the optimum",
+                       description="Run a saved agent for N episodes and report its success "
+                       "rate (over all episodes and over the starts from which a gait exists) "
+                       "and its regrasps beside the exact optimum's and the rule-based gait's "
+                       "from the same starts, under the same contact model. By default the env "
+                       "settings the model was trained with (from its card).")
+    p.add_argument("model", metavar="MODEL", help="a model zip (runs/<run>/model.zip, "
+                   "agents/models/ellipse.zip)")
+    p.add_argument("--env", metavar="ID", help="GraspGait-v0, GraspGaitRandom-v0 or "
+                   "GraspGaitMujoco-v0 (default: the training env)")
+    p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
+    p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
+    p.add_argument("--episodes", type=int, default=100, help="episodes (default 100)")
+    p.add_argument("--seed", type=int, default=0, help="first reset seed (default 0)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="an env keyword argument (YAML value), e.g. bundled_fraction=0; "
+                   "repeatable")
+    p.add_argument("--json", metavar="FILE", help="write the result JSON (per-episode records)")
+    _add_ray_option(p, "split the episodes over Ray tasks; same result as serially")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_evaluate)
+
+
+# --- story ----------------------------------------------------------------------------
+
+
+def _cmd_story(args: argparse.Namespace) -> int:
+    from agents.bench import shipped_models_dir
+    from agents.story import gait_model_of, tell_story
+
+    mu = None if args.mu is None else _check_mu(args.mu)
+    # a shipped agent's name (agents/models/NAME.zip) or a path
+    model = (args.model if args.model.endswith(".zip")
+             else str(shipped_models_dir() / f"{args.model}.zip"))
+    start = (None if args.start is None
+             else _parse_start(args.start, gait_model_of(model, args.object, mu)))
+    result = tell_story(model, args.out, start=start, object=args.object, mu=mu)
+    print(result["table"])
+    files = result["files"]
+    print("wrote " + ", ".join(files.values()))
+    if "learned_plan" not in files:
+        print("the learned gait did not reach the turn from this start")
+        return 1
+    return 0
+
+
+def _add_story(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("story", help="rule-based, optimal and learned gaits side by side",
+                       description="From one start grasp, the thesis's rule-based gait, the "
+                       "exact optimum and a saved agent's gait turn the object 360 deg: drawn "
+                       "on the extended grasp map with a comparison table, each written as a "
+                       "plan JSON (replay the learned one on the MuJoCo hand with `graspgait "
+                       "simulate OUT/OBJECT_learned_plan.json --video F.mp4`). Exit 1 when the "
+                       "agent does not reach the turn.")
+    p.add_argument("model", metavar="MODEL", nargs="?", default="ellipse",
+                   help="a shipped agent (circle, ellipse, pentagon, hexagon, random: "
+                   "agents/models/NAME.zip) or a model zip with its card (default ellipse)")
+    p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
+    p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
+    p.add_argument("--start", metavar="PHI1,PHI2", help="start contacts at theta = 0 (deg, "
+                   "object frame; default: the first of 24 spread starts with a gait)")
+    p.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
+    p.set_defaults(func=_cmd_story)
 
 
 # --- registry -------------------------------------------------------------------------
@@ -476,6 +787,9 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_bench,
     _add_simulate,
     _add_perf,
+    _add_train,
+    _add_evaluate,
+    _add_story,
 ]
 
 

@@ -49,7 +49,10 @@ SPEEDUP_TARGET = 10.0  # vectorized grasp map vs the per-pair Python loop
 BENCHMARK_MODULES: list[str] = [
     "baselines.bench",
     "graspgait_env.envs.bench",
+    "graspgait_env.envs.vector_bench",
     "graspgait_env.sim.perf_rows",
+    "graspgait_env.envs.render_bench",
+    "agents.throughput",
 ]
 
 

@@ -7,7 +7,7 @@ reads them from the checkout. Code never builds a path from ``__file__`` to reac
 it asks this module, which goes through :mod:`importlib.resources`.
 
 Layout (``KIND/NAME.yaml``): ``objects/`` (object files), ``hands/`` (hand files),
-``sim/`` (simulation configs).
+``sim/`` (simulation configs), ``train/`` (training configs of ``graspgait train``).
 
 >>> from graspgait_env.resources import bundled_names
 >>> "ellipse" in bundled_names("objects")
@@ -22,11 +22,11 @@ from pathlib import Path
 __all__ = ["CONFIG_PACKAGE", "KINDS", "bundled_file", "bundled_names", "config_dir"]
 
 CONFIG_PACKAGE = "graspgait_env.configs"
-KINDS = ("objects", "hands", "sim")
+KINDS = ("objects", "hands", "sim", "train")
 
 
 def config_dir(kind: str) -> Path:
-    """The folder of bundled ``kind`` files (``"objects"``, ``"hands"``, ``"sim"``).
+    """The folder of bundled ``kind`` files (``"objects"``, ``"hands"``, ``"sim"``, ``"train"``).
 
     Raises
     ------

@@ -94,13 +94,13 @@ BAD_INPUT: list[tuple[str, list[str]]] = [
 # valid questions without an answer: exit 1, at most three lines
 NO_GAIT: list[tuple[str, list[str]]] = [
     # a regular pentagon at mu 0.3 has no stable grasp at all (thesis 3.3)
-    ("plan pentagon --mu 0.3 --planner rule", ["mu"]),
-    ("plan pentagon --mu 0.3 --planner back-and-forth", ["mu"]),
-    ("plan pentagon --mu 0.3 --planner forward", ["mu"]),
-    ("plan pentagon --mu 0.3 --planner optimal", ["mu"]),
-    ("plan pentagon --mu 0.3 --planner best-first", ["mu"]),
-    ("plan pentagon --mu 0.3 --planner modified", ["mu"]),
-    ("plan ellipse --mu 0.7 --planner optimal --start 0,180", ["360"]),
+    ("plan pentagon --mu 0.3 --planner rule --point-contacts", ["mu"]),
+    ("plan pentagon --mu 0.3 --planner back-and-forth --point-contacts", ["mu"]),
+    ("plan pentagon --mu 0.3 --planner forward --point-contacts", ["mu"]),
+    ("plan pentagon --mu 0.3 --planner optimal --point-contacts", ["mu"]),
+    ("plan pentagon --mu 0.3 --planner best-first --point-contacts", ["mu"]),
+    ("plan pentagon --mu 0.3 --planner modified --point-contacts", ["mu"]),
+    ("plan ellipse --mu 0.7 --planner optimal --start 0,180 --point-contacts", ["360"]),
 ]
 
 
@@ -135,7 +135,7 @@ def tmp(tmp_path_factory) -> Path:
     (d / "afile").write_text("a file, not a folder")
     good = d / "good.json"
     assert main(["plan", "pentagon", "--mu", "0.7", "--planner", "optimal", "--start", "50,270",
-                 "--json", str(good)]) == 0
+                 "--point-contacts", "--json", str(good)]) == 0
     for name, doc in _plan_variants(json.loads(good.read_text())).items():
         (d / name).write_text(json.dumps(doc))
     return d

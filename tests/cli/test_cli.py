@@ -186,7 +186,7 @@ def test_no_gait_is_three_lines_and_verbose_tells_all(capsys):
 def test_bench_exit_codes(tmp_path, capsys):
     out = tmp_path / "b.json"
     argv = ["bench", "--objects", "circle", "--mus", "0.7", "--starts", "1", "--planners",
-            "rule,optimal"]
+            "rule,optimal", "--agents", "none"]
     assert main([*argv, "--json", str(out)]) == 0
     assert {r["planner"] for r in json.loads(out.read_text())["runs"]} == {"rule", "optimal"}
     assert main([*argv, "--starts", "0"]) == 2
@@ -202,7 +202,7 @@ def test_simulate_exit_codes(tmp_path, capsys):
                  "--json", str(plan)]) == 0
     assert main(["simulate", str(plan), "--quiet"]) == 0
     slippery = tmp_path / "slippery.yaml"
-    slippery.write_text(DEFAULT_SIM_CONFIG.read_text().replace("finger_mu: 1.0 ",
+    slippery.write_text(DEFAULT_SIM_CONFIG.read_text().replace("finger_mu: null ",
                                                                 "finger_mu: 0.05"))
     assert main(["simulate", str(plan), "--quiet", "--config", str(slippery)]) == 1
     assert main(["simulate", str(tmp_path / "none.json")]) == 2

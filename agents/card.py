@@ -1,0 +1,194 @@
+"""Saved agents: the SB3 ``.zip`` and its model card, a JSON file beside it.
+
+Every model ``graspgait train`` writes (final model, best model, checkpoints) is a pair
+``NAME.zip`` + ``NAME.json``. The card says what the model is and how to run it again:
+
+- ``format``: ``"graspgait-model-card/1"``;
+- ``algo`` (``maskable_ppo`` | ``ppo``), ``env_id``, ``env_kwargs`` (object, mu,
+  contact model, reward weights, ...), ``wrappers``, ``contact_model`` (the env's,
+  ``"point"`` before contact models existed);
+- ``config`` (every :class:`~agents.config.TrainConfig` field), ``seed``, ``steps``
+  (environment steps trained), ``wall_s`` (training wall time, seconds), ``run_dir``;
+- ``eval``: the latest periodic evaluation (success rates, regrasps against the
+  optimum), when there was one;
+- ``versions``: graspgait_env, stable-baselines3, sb3-contrib, torch, gymnasium, Python;
+  ``created`` (UTC, ISO 8601).
+
+:func:`load_agent` reads both back. A ``.zip`` without a card loads too: one saved by
+RL Zoo gets a card made from RL Zoo's saved hyper-parameters (env id, env keywords,
+``env_wrapper``); any other gets a card with only ``algo``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import zipfile
+from collections.abc import Mapping
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from graspgait_env.atomic import atomic_write, write_text_atomic
+from graspgait_env.errors import GraspGaitInputError
+
+__all__ = ["CARD_FORMAT", "card_path", "load_agent", "read_card", "save_agent", "versions"]
+
+CARD_FORMAT = "graspgait-model-card/1"
+
+
+def card_path(model_path: str | os.PathLike[str]) -> Path:
+    """The card of ``model_path``: its name with ``.json`` (``model.zip`` -> ``model.json``)."""
+    return Path(model_path).with_suffix(".json")
+
+
+def versions() -> dict[str, str]:
+    """Versions of the packages a saved model depends on."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version()}
+    for pkg in ("graspgait_env", "stable_baselines3", "sb3_contrib", "torch", "gymnasium"):
+        try:
+            out[pkg] = version(pkg)
+        except PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, Mapping):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (str, int, float, bool)) or x is None:
+        return x
+    if hasattr(x, "item"):  # NumPy scalars
+        return x.item()
+    return str(x)
+
+
+def save_agent(model: Any, path: str | os.PathLike[str], card: Mapping[str, Any]) -> Path:
+    """Save ``model`` to ``path`` (``.zip``) and its card beside it, both atomically.
+
+    ``card`` gets ``format``, ``created`` and ``versions`` added.
+    """
+    path = Path(path)
+    if path.suffix != ".zip":
+        raise GraspGaitInputError(f"model path {str(path)!r}: must end in .zip")
+    atomic_write(path, lambda fh: model.save(fh))
+    full = {"format": CARD_FORMAT, **_jsonable(card),
+            "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "versions": versions()}
+    write_text_atomic(card_path(path), json.dumps(full, indent=1) + "\n")
+    return path
+
+
+def read_card(model_path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The card beside ``model_path`` (an empty dict when there is none).
+
+    Raises
+    ------
+    GraspGaitInputError
+        The card exists but is not a JSON object.
+    """
+    p = card_path(model_path)
+    if not p.is_file():
+        return {}
+    try:
+        card = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise GraspGaitInputError(f"model card {str(p)!r}: cannot read it ({exc}); delete it "
+                                  "to load the model without one") from None
+    if not isinstance(card, dict):
+        raise GraspGaitInputError(f"model card {str(p)!r}: must be a JSON object")
+    return card
+
+
+class _RLZooLoader(yaml.SafeLoader):
+    """Reads RL Zoo's ``config.yml`` / ``args.yml`` (OrderedDicts as Python tags) safely."""
+
+
+_RLZooLoader.add_constructor(
+    "tag:yaml.org,2002:python/object/apply:collections.OrderedDict",
+    lambda loader, node: dict(loader.construct_sequence(node.value[0], deep=True)))
+
+
+def _rlzoo_card(path: Path) -> dict[str, Any]:
+    """A card made from RL Zoo's saved run (``LOG/ALGO/ENV_N/ENV/{config,args}.yml``).
+
+    RL Zoo saves ``ENV.zip``, ``best_model.zip`` and checkpoints in the run folder and
+    its hyper-parameters in the subfolder named by the env id; from them: ``algo``,
+    ``env_id``, ``env_kwargs`` and ``wrappers`` (its ``env_wrapper``). Empty when the
+    zip does not sit in such a folder.
+    """
+    for sub in sorted(p for p in path.parent.iterdir() if p.is_dir()):
+        cfg, args = sub / "config.yml", sub / "args.yml"
+        if not (cfg.is_file() and args.is_file()):
+            continue
+        try:
+            hyper = yaml.load(cfg.read_text(encoding="utf-8"), Loader=_RLZooLoader) or {}
+            argv = yaml.load(args.read_text(encoding="utf-8"), Loader=_RLZooLoader) or {}
+        except (OSError, yaml.YAMLError):
+            return {}
+        if not isinstance(hyper, dict) or not isinstance(argv, dict):
+            return {}
+        wrapper = hyper.get("env_wrapper")
+        wrappers = wrapper if isinstance(wrapper, list) else ([wrapper] if wrapper else [])
+        if not all(isinstance(w, str) for w in wrappers):
+            return {}  # wrappers with keyword arguments: not read here
+        return {"algo": argv.get("algo"), "env_id": argv.get("env", sub.name),
+                "env_kwargs": argv.get("env_kwargs") or {}, "wrappers": wrappers,
+                "source": f"RL Zoo run {sub}"}
+    return {}
+
+
+def _is_maskable(path: Path) -> bool:
+    """Whether the zip holds a MaskablePPO policy (read from its ``data`` entry)."""
+    try:
+        with zipfile.ZipFile(path) as zf:
+            data = json.loads(zf.read("data"))
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return False
+    policy = json.dumps(data.get("policy_class", ""))
+    return "Maskable" in policy
+
+
+def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple[Any, dict]:
+    """Load a saved agent and its card.
+
+    The algorithm is read from the zip: MaskablePPO when its policy class is a maskable
+    one, else PPO (the returned card's ``algo`` says which).
+
+    Returns
+    -------
+    model, card
+        The SB3 model (on ``device``) and the card (``{}`` when absent).
+
+    Raises
+    ------
+    GraspGaitInputError
+        No such file, or not an SB3 model zip.
+    """
+    path = Path(model_path)
+    if not path.is_file() and path.suffix != ".zip" and path.with_suffix(".zip").is_file():
+        path = path.with_suffix(".zip")
+    if not path.is_file():
+        raise GraspGaitInputError(f"MODEL {str(model_path)!r}: no such file; give a .zip saved "
+                                  "by `graspgait train` (e.g. runs/<run>/model.zip or "
+                                  "agents/models/ellipse.zip)")
+    card = read_card(path) or _rlzoo_card(path)
+    # the zip itself says which algorithm saved it (a card may be stale or RL Zoo's)
+    card["algo"] = algo = "maskable_ppo" if _is_maskable(path) else "ppo"
+    if algo == "maskable_ppo":
+        from sb3_contrib import MaskablePPO as cls
+    else:
+        from stable_baselines3 import PPO as cls
+    try:
+        model = cls.load(path, device=device)
+    except (zipfile.BadZipFile, KeyError, ValueError) as exc:
+        raise GraspGaitInputError(f"MODEL {str(model_path)!r}: not a stable-baselines3 model "
+                                  f"zip ({type(exc).__name__}: {exc})") from None
+    return model, card

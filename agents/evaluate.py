@@ -1,0 +1,419 @@
+"""Evaluate a trained agent against the thesis's rule-based gait and the exact optimum.
+
+Protocol. Episode ``i`` starts with ``env.reset(seed=seed + i)``: a start grasp at
+θ = 0 drawn by the env (and, in ``GraspGaitRandom-v0``, an object and ``mu``). The agent
+plays until the episode ends (success, dead end, wrong way, or the 500-step limit).
+From the same start grasp, under the same gait model (object, ``mu``, hand, grid and
+contact model: the env's own ``model``), the exact planner
+(:func:`graspgait_env.planners.exact.optimal_gait`, the fewest regrasps) and the
+thesis's rule-based method (:func:`graspgait_env.planners.rule_based.rule_based`, 6.5)
+plan the same turn. The env draws some starts from which no gait exists (the exact
+planner proves it); the success rate is reported over all episodes and over the
+*solvable* starts, those with a gait.
+
+Averages (the choice made here, where "mean regrasps" could mean several things):
+
+- ``mean_regrasps``: the agent's regrasps over its **successful** episodes;
+- ``mean_optimal_regrasps``: the optimum's regrasps over the **same** episodes, so
+  ``regrasps_vs_optimal = mean_regrasps / mean_optimal_regrasps`` compares like with
+  like (and is >= 1: no agent beats the optimum);
+- ``mean_rule_regrasps``: the rule-based gait's regrasps over the agent's successful
+  episodes from which the rule-based method also found a gait, with
+  ``regrasps_vs_rule`` the agent's mean over those same episodes divided by it.
+
+Optima and rule-based gaits are cached per (grasp map, hand grid, start, turn)
+(:class:`ReferenceGaits`), so repeated evaluations (training's periodic evaluation)
+pay for each start once.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import statistics
+import time
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from agents.card import load_agent
+from agents.envs import contact_model_of, env_kwargs_for, make_env
+from agents.seeding import seed_everything
+from graspgait_env.atomic import write_text_atomic
+from graspgait_env.envs.config import check_count, check_mu, check_object
+from graspgait_env.envs.registration import ENV_IDS
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.gait import GaitModel, GaitState
+
+__all__ = ["ReferenceGaits", "evaluate", "play_episode", "run_episodes", "summarize_episodes",
+           "write_evaluation", "EVAL_SEED"]
+
+EVAL_SEED = 10_000  # first reset seed of training's periodic evaluation (fixed starts)
+
+
+class ReferenceGaits:
+    """Regrasps of the exact optimum and of the rule-based gait per start, cached.
+
+    The key is the gait model's grasp map (its bytes' digest), its hand grid, the start
+    contacts and the turn in grid steps: everything the planners read.
+    """
+
+    def __init__(self) -> None:
+        self._cache: dict[tuple, tuple[int | None, int | None]] = {}
+        self._exists: dict[tuple, bool] = {}
+        self._digests: dict[int, tuple[GaitModel, str]] = {}
+
+    def _model_key(self, model: GaitModel) -> tuple:
+        held = self._digests.get(id(model))
+        if held is None or held[0] is not model:
+            digest = hashlib.sha1(np.packbits(model.stable).tobytes()).hexdigest()
+            self._digests[id(model)] = held = (model, digest)
+            if len(self._digests) > 256:  # GraspGaitRandom-v0 makes a model per reset
+                self._digests = {id(model): held}
+        return (held[1], model.n, tuple(int(x) for x in model.ws_start),
+                tuple(int(x) for x in model.ws_width))
+
+    def _key(self, model: GaitModel, start: GaitState, turn_deg: float) -> tuple:
+        return (self._model_key(model), tuple(start.contacts), model.turn_steps(turn_deg))
+
+    def gait_exists(self, model: GaitModel, start: GaitState, turn_deg: float) -> bool:
+        """Whether a gait turns the object ``turn_deg`` from ``start``, decided cheaply.
+
+        The rule-based method first (milliseconds; a plan it finds is a proof), the exact
+        planner only when it finds none (its "no gait" is a proof over its window).
+        """
+        from graspgait_env.planners.rule_based import rule_based
+
+        key = self._key(model, start, turn_deg)
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit[0] is not None
+        exists = self._exists.get(key)
+        if exists is None:
+            exists = rule_based(model, start, turn_deg).success or (
+                self.regrasps(model, start, turn_deg)[0] is not None)
+            self._exists[key] = exists
+        return exists
+
+    def regrasps(self, model: GaitModel, start: GaitState,
+                 turn_deg: float) -> tuple[int | None, int | None]:
+        """``(optimal, rule_based)`` regrasps for the turn from ``start`` (None: no gait).
+
+        Parameters
+        ----------
+        model
+            The gait model (the env's ``unwrapped.model``).
+        start
+            A legal grasp at ``k = 0``.
+        turn_deg
+            The requested turn (degrees, counter-clockwise positive).
+        """
+        from graspgait_env.planners.exact import optimal_gait
+        from graspgait_env.planners.rule_based import rule_based
+
+        key = self._key(model, start, turn_deg)
+        hit = self._cache.get(key)
+        if hit is None:
+            opt = optimal_gait(model, start, turn_deg)
+            rule = rule_based(model, start, turn_deg) if opt.success else None
+            hit = (opt.regrasps if opt.success else None,
+                   rule.regrasps if rule is not None and rule.success else None)
+            self._cache[key] = hit
+        return hit
+
+
+def _start_dict(model: GaitModel, s: GaitState) -> dict[str, float]:
+    """``{finger number: contact_deg}`` of the held fingers (docs/formats.md's plan form)."""
+    return {str(f + 1): float(model.contact_deg(s.contacts[f])) for f in s.held()}
+
+
+def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
+                 seed: int | None = None, options: Mapping[str, Any] | None = None
+                 ) -> dict[str, Any]:
+    """Reset ``env`` (``seed``, ``options``) and play one episode with ``predict``.
+
+    Returns
+    -------
+    dict
+        ``model`` and ``start_state`` (the env's gait model and start grasp of this
+        episode), ``success``, ``regrasps``, ``path_length`` (moves made: a move changes
+        the (commanded) gait state, an illegal no-op does not), ``steps``,
+        ``illegal_actions`` (actions chosen that were not legal moves), ``turn_deg``
+        (turn achieved, degrees) and ``wall_s``.
+    """
+    u = env.unwrapped
+    t0 = time.perf_counter()
+    obs, info = env.reset(seed=seed, options=dict(options) if options else None)
+    model, start = u.model, u.state
+    steps = illegal = moves = 0
+    state, done = start, False
+    while not done:
+        mask = np.asarray(u.action_masks(), dtype=bool)
+        action = int(predict(obs, mask))
+        illegal += not mask[action] if 0 <= action < mask.size else 1
+        obs, _, terminated, truncated, info = env.step(np.int64(action))
+        steps += 1
+        moved = u.state
+        moves += moved != state
+        state = moved
+        done = terminated or truncated
+    return {"model": model, "start_state": start,
+            "success": bool(info.get("is_success", False)),
+            "regrasps": int(info.get("regrasps", 0)), "path_length": moves, "steps": steps,
+            "illegal_actions": illegal, "turn_deg": float(info.get("turn_deg", 0.0)),
+            "wall_s": time.perf_counter() - t0}
+
+
+def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, episodes: int,
+                 seed: int = 0, references: ReferenceGaits | None = None,
+                 progress: bool = False, desc: str = "evaluate") -> list[dict[str, Any]]:
+    """Play ``episodes`` episodes with ``predict`` and compare each with the references.
+
+    Parameters
+    ----------
+    predict
+        ``predict(observation, action_mask) -> action``.
+    env
+        A GraspGait env made by :func:`agents.envs.make_env` (any id, wrapped or not).
+    episodes
+        Number of episodes; episode ``i`` resets with seed ``seed + i``.
+    seed
+        First reset seed.
+    references
+        Cache of optimal and rule-based regrasps (a fresh one when None).
+    progress
+        Show a tqdm bar.
+
+    Returns
+    -------
+    list of dict
+        One record per episode: ``start`` ({finger: contact_deg}), ``object``, ``mu``,
+        ``success``, ``solvable`` (a gait exists from the start), ``regrasps``,
+        ``path_length`` (moves made: regrasps + rotations), ``steps`` (actions, illegal
+        ones included), ``illegal_actions`` (actions the agent chose that were not legal
+        moves; a wrapper such as :class:`agents.wrappers.LegalActionWrapper` may have
+        played a legal one instead), ``optimal_regrasps`` and ``rule_regrasps`` (None:
+        no gait found), ``wall_s`` (the agent's episode, references excluded).
+    """
+    refs = references if references is not None else ReferenceGaits()
+    turn = float(env.unwrapped.config.turn_deg)
+    out = []
+    for i in tqdm(range(episodes), desc=desc, disable=not progress, unit="ep"):
+        ep = play_episode(predict, env, seed=seed + i)
+        model, start = ep.pop("model"), ep.pop("start_state")
+        opt, rule = refs.regrasps(model, start, turn)
+        out.append({
+            "start": _start_dict(model, start), "object": model.shape.name,
+            "mu": float(model.mu), "success": ep["success"], "solvable": opt is not None,
+            "regrasps": ep["regrasps"], "path_length": ep["path_length"],
+            "steps": ep["steps"], "illegal_actions": ep["illegal_actions"],
+            "optimal_regrasps": opt, "rule_regrasps": rule, "wall_s": ep["wall_s"],
+        })
+    return out
+
+
+def _mean(xs: list[float]) -> float | None:
+    return statistics.fmean(xs) if xs else None
+
+
+def _ratio(a: float | None, b: float | None) -> float | None:
+    return a / b if a is not None and b else None
+
+
+def summarize_episodes(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """The aggregate numbers of :func:`run_episodes`' records (see the module docstring).
+
+    Returns
+    -------
+    dict
+        ``success_rate`` (all episodes), ``success_rate_solvable`` (episodes whose start
+        has a gait; None when none has), ``solvable_episodes``, ``mean_regrasps``,
+        ``mean_optimal_regrasps``, ``regrasps_vs_optimal``, ``mean_rule_regrasps``,
+        ``regrasps_vs_rule``, ``rule_success_rate_solvable``, ``mean_path_length``
+        (successful episodes), ``illegal_action_rate`` and ``mean_wall_s``. Means are
+        None when they have no episode.
+    """
+    n = len(records)
+    ok = [r for r in records if r["success"]]
+    solvable = [r for r in records if r["solvable"]]
+    ok_rule = [r for r in ok if r["rule_regrasps"] is not None]
+    mean_regrasps = _mean([r["regrasps"] for r in ok])
+    # the agent succeeded, so a gait exists: the optimum is known for every one of `ok`
+    mean_opt = _mean([r["optimal_regrasps"] for r in ok if r["optimal_regrasps"] is not None])
+    mean_rule = _mean([r["rule_regrasps"] for r in ok_rule])
+    steps = sum(r["steps"] for r in records)
+    return {
+        "n_episodes": n,
+        "success_rate": len(ok) / n if n else None,
+        "solvable_episodes": len(solvable),
+        "success_rate_solvable": (sum(r["success"] for r in solvable) / len(solvable)
+                                  if solvable else None),
+        "mean_regrasps": mean_regrasps,
+        "mean_optimal_regrasps": mean_opt,
+        "regrasps_vs_optimal": _ratio(mean_regrasps, mean_opt),
+        "mean_rule_regrasps": mean_rule,
+        "regrasps_vs_rule": _ratio(_mean([r["regrasps"] for r in ok_rule]), mean_rule),
+        "rule_success_rate_solvable": (sum(r["rule_regrasps"] is not None for r in solvable)
+                                       / len(solvable) if solvable else None),
+        "mean_path_length": _mean([r["path_length"] for r in ok]),
+        "illegal_action_rate": (sum(r["illegal_actions"] for r in records) / steps
+                                if steps else None),
+        "mean_wall_s": _mean([r["wall_s"] for r in records]),
+    }
+
+
+def agent_predictor(model: Any, deterministic: bool = True
+                    ) -> Callable[[np.ndarray, np.ndarray], int]:
+    """``predict(obs, mask) -> action`` of an SB3 model (the mask is used by MaskablePPO)."""
+    from sb3_contrib import MaskablePPO
+
+    if isinstance(model, MaskablePPO):
+        def predict(obs: np.ndarray, mask: np.ndarray) -> int:
+            a, _ = model.predict(obs, deterministic=deterministic, action_masks=mask)
+            return int(a)
+    else:
+        def predict(obs: np.ndarray, mask: np.ndarray) -> int:
+            a, _ = model.predict(obs, deterministic=deterministic)
+            return int(a)
+    return predict
+
+
+def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
+             object: Any = None, mu: float | None = None, episodes: int = 100, seed: int = 0,
+             deterministic: bool = True, env_overrides: Mapping[str, Any] | None = None,
+             progress: bool = False) -> dict[str, Any]:
+    """Evaluate a saved agent (``model.zip``) and compare it with the optimum and the rules.
+
+    Parameters
+    ----------
+    model_path
+        A ``.zip`` saved by ``graspgait train`` (its model card ``<stem>.json`` beside it
+        gives the env it was trained in) or by SB3 / RL Zoo (then give ``env_id`` and, for
+        ``GraspGait-v0``, ``object``/``mu`` unless the env defaults are meant).
+    env_id
+        Evaluate in this id (default: the training id). A model trained on
+        ``GraspGaitRandom-v0`` is evaluated on one object with ``object=``: the id
+        becomes ``GraspGait-v0`` unless given.
+    object
+        Bundled object name, object YAML path or Shape (default: the trained one), also
+        an object the model never saw.
+    mu
+        Friction coefficient (default: the trained one).
+    episodes
+        Episodes (reset seeds ``seed .. seed + episodes - 1``).
+    seed
+        First reset seed.
+    deterministic
+        Greedy actions (the policy's mode) when True; else sampled, from torch seeded
+        with ``seed`` (:func:`agents.seeding.seed_everything`).
+    env_overrides
+        Further keyword arguments of the env (e.g. ``{"object_seeds": [1000000,
+        1100000], "exclude_seeds": None, "bundled_fraction": 0}`` for held-out
+        procedural objects in ``GraspGaitRandom-v0``).
+    progress
+        Show a progress bar.
+
+    Returns
+    -------
+    dict
+        The aggregate numbers of :func:`summarize_episodes`, the per-episode records
+        under ``episodes``, and ``model`` (path, algo, card), ``env_id``, ``env_kwargs``,
+        ``object``, ``mu`` (None when drawn per episode), ``contact_model``, ``seed``,
+        ``deterministic``, ``wall_s``.
+
+    Raises
+    ------
+    GraspGaitInputError
+        A missing or unreadable model, a bad id, object, ``mu`` or episode count.
+    """
+    episodes = check_count("episodes", episodes, 1, 100)
+    seed = check_count("seed", seed, 0, 0)
+    if object is not None:
+        check_object(object)
+    if mu is not None:
+        mu = check_mu(mu)
+    if env_id is not None and env_id not in ENV_IDS:
+        raise GraspGaitInputError(f"--env {env_id!r}: not a GraspGait id; use one of "
+                                  f"{', '.join(ENV_IDS)}")
+    t0 = time.perf_counter()
+    seed_everything(seed)  # the policy's sampling, when not deterministic
+    model, card = load_agent(model_path)
+    trained_id = card.get("env_id") or env_id or "GraspGait-v0"
+    if env_id is None:
+        env_id = ("GraspGait-v0" if trained_id == "GraspGaitRandom-v0" and object is not None
+                  else trained_id)
+    kwargs = env_kwargs_for(env_id, trained_id, card.get("env_kwargs") or {}, object, mu,
+                            contact_model=card.get("contact_model"))
+    kwargs.update(env_overrides or {})
+    env = make_env(env_id, kwargs, card.get("wrappers") or ())
+    try:
+        if env.observation_space.shape != model.observation_space.shape:
+            raise GraspGaitInputError(
+                f"model {str(model_path)!r}: observes {model.observation_space.shape}, the "
+                f"env {env_id} gives {env.observation_space.shape}; evaluate with the env "
+                "settings the model was trained with (hand, n, map window)")
+        records = run_episodes(agent_predictor(model, deterministic), env, episodes, seed,
+                               progress=progress)
+        contact_model = contact_model_of(env)
+    finally:
+        env.close()
+    summary = summarize_episodes(records)
+    objects = sorted({r["object"] for r in records})
+    mus = sorted({r["mu"] for r in records})
+    return {
+        **summary,
+        "model": {"path": str(model_path), "algo": card.get("algo"),
+                  "name": card.get("config", {}).get("name"), "steps": card.get("steps"),
+                  "seed": card.get("seed")},
+        "env_id": env_id,
+        "env_kwargs": {k: (v if isinstance(v, (str, int, float, bool, list, dict, type(None)))
+                           else str(v)) for k, v in kwargs.items()},
+        "object": objects[0] if len(objects) == 1 else None,
+        "mu": mus[0] if len(mus) == 1 else None,
+        "contact_model": contact_model,
+        "seed": seed,
+        "deterministic": bool(deterministic),
+        "wall_s": time.perf_counter() - t0,
+        "episodes": records,
+    }
+
+
+def write_evaluation(result: Mapping[str, Any], path: str | os.PathLike[str]) -> Path:
+    """Write :func:`evaluate`'s result as JSON (atomic; NaN written as null)."""
+    def clean(x: Any) -> Any:
+        if isinstance(x, float) and not math.isfinite(x):
+            return None
+        if isinstance(x, Mapping):
+            return {str(k): clean(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v) for v in x]
+        return x
+
+    return write_text_atomic(path, json.dumps(clean(result), indent=1) + "\n")
+
+
+def format_evaluation(result: Mapping[str, Any]) -> str:
+    """A few lines for the terminal: success rates and regrasps beside the references."""
+    def f(x: Any, spec: str = ".2f") -> str:
+        return "-" if x is None else format(x, spec)
+
+    where = (f"{result['env_id']}, object {result['object'] or 'per episode'}, "
+             f"mu {f(result['mu'], 'g') if result['mu'] is not None else 'per episode'}, "
+             f"contact model {result['contact_model']}")
+    return "\n".join([
+        f"{result['model']['path']} ({result['model']['algo'] or 'SB3 model'}) in {where}",
+        f"success: {f(result['success_rate'], '.1%')} of {result['n_episodes']} episodes; "
+        f"{f(result['success_rate_solvable'], '.1%')} of the {result['solvable_episodes']} "
+        "starts from which a gait exists",
+        f"regrasps (successful episodes): agent {f(result['mean_regrasps'])}, optimum "
+        f"{f(result['mean_optimal_regrasps'])} (x{f(result['regrasps_vs_optimal'], '.3f')}), "
+        f"rule-based {f(result['mean_rule_regrasps'])} "
+        f"(agent/rule x{f(result['regrasps_vs_rule'], '.3f')})",
+        f"illegal actions {f(result['illegal_action_rate'], '.1%')}; "
+        f"wall time {result['wall_s']:.1f} s",
+    ])

@@ -1,0 +1,325 @@
+"""Train a PPO or MaskablePPO agent on a GraspGait env from a :class:`~agents.config.TrainConfig`.
+
+A run lives in its own folder, ``{run_root}/{env_id}-{config name}-s{seed}-{YYYYmmdd-HHMMSS}``:
+
+- ``config.yaml``: the resolved config (every field, after ``--set``);
+- ``tb/``: TensorBoard logs (SB3's ``rollout/``, ``train/``, ``time/`` and this
+  module's ``eval/``), with the config as hyper-parameters;
+- ``evaluations.json``: every periodic evaluation;
+- ``checkpoints/model_{steps}_steps.zip`` (+ ``.json`` cards), every
+  ``checkpoint_freq`` steps; ``graspgait train CONFIG --resume`` one of them continues
+  the run in the same folder;
+- ``best.zip`` (+ card): the model of the best evaluation (highest success rate over
+  solvable starts, then fewest regrasps relative to the optimum);
+- ``model.zip`` + ``model.json``: the final model and its card (:mod:`agents.card`).
+
+The periodic evaluation (every ``eval_freq`` steps and at the end) plays
+``eval_episodes`` episodes from fixed starts (reset seeds 10000, 10001, ...) in a
+separate env made like the training ones, greedy actions, and compares the agent with
+the exact optimum and the rule-based gait from the same starts
+(:func:`agents.evaluate.run_episodes`; the references are computed once per start).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+import yaml
+from tqdm.auto import tqdm
+
+from agents.card import read_card, save_agent
+from agents.config import TrainConfig
+from agents.envs import contact_model_of, import_object, make_env
+from agents.evaluate import (
+    EVAL_SEED,
+    ReferenceGaits,
+    agent_predictor,
+    run_episodes,
+    summarize_episodes,
+)
+from agents.seeding import seed_everything, set_torch_threads
+from graspgait_env.atomic import write_text_atomic
+from graspgait_env.errors import GraspGaitInputError
+
+__all__ = ["TrainResult", "train", "run_name", "build_model", "make_vec_env_for"]
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """What :func:`train` returns.
+
+    Attributes
+    ----------
+    run_dir
+        The run's folder.
+    model_path
+        The final model (``run_dir/model.zip``; its card is ``model.json``).
+    steps
+        Environment steps trained (all envs together; counted from 0 across resumes).
+    wall_s
+        Training wall time (s), including the runs this one resumed.
+    last_eval
+        The final evaluation's numbers (:func:`agents.evaluate.summarize_episodes`).
+    """
+
+    run_dir: Path
+    model_path: Path
+    steps: int
+    wall_s: float
+    last_eval: dict[str, Any]
+
+
+def run_name(config: TrainConfig, when: datetime | None = None) -> str:
+    """``{env_id}-{config name}-s{seed}-{YYYYmmdd-HHMMSS}`` (local time)."""
+    stamp = (when or datetime.now()).strftime("%Y%m%d-%H%M%S")
+    return f"{config.env_id}-{config.name}-s{config.seed}-{stamp}"
+
+
+def _new_run_dir(config: TrainConfig) -> Path:
+    root = Path(config.run_root)
+    base = root / run_name(config)
+    path, i = base, 1
+    while path.exists():  # two runs in the same second
+        i += 1
+        path = Path(f"{base}-{i}")
+    path.mkdir(parents=True)
+    return path
+
+
+def make_vec_env_for(config: TrainConfig, n_envs: int | None = None) -> Any:
+    """The SB3 vector env of ``config`` (``n_envs`` envs, env ``i`` seeded ``seed + i``)."""
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    env_id, kwargs, wrappers = config.env_id, dict(config.env_kwargs), tuple(config.wrappers)
+    make_env(env_id, kwargs, wrappers).close()  # bad keywords fail here, in this process
+    if config.vec_env == "batched":
+        from agents.vec_env import make_batched_vec_env
+
+        if env_id != "GraspGait-v0" or wrappers:
+            raise GraspGaitInputError(
+                f"vec_env='batched' with env_id={env_id!r}, wrappers={list(wrappers)}: the "
+                "batched env is GraspGait-v0 without wrappers; use vec_env=dummy")
+        return make_batched_vec_env(n_envs or config.n_envs, seed=config.seed,
+                                    env_kwargs=kwargs)
+    cls = SubprocVecEnv if config.vec_env == "subproc" else DummyVecEnv
+    return make_vec_env(lambda: make_env(env_id, kwargs, wrappers),
+                        n_envs=n_envs or config.n_envs, seed=config.seed, vec_env_cls=cls)
+
+
+def _algo_class(algo: str) -> type:
+    if algo == "maskable_ppo":
+        from sb3_contrib import MaskablePPO
+
+        return MaskablePPO
+    from stable_baselines3 import PPO
+
+    return PPO
+
+
+def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
+    """A fresh PPO / MaskablePPO model for ``config`` on the vector env ``env``."""
+    import torch
+
+    policy_kwargs: dict[str, Any] = {
+        "net_arch": config.net_arch,
+        "activation_fn": {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config.activation],
+    }
+    if config.features_extractor is not None:
+        policy_kwargs["features_extractor_class"] = import_object(config.features_extractor,
+                                                                  "features_extractor")
+        policy_kwargs["features_extractor_kwargs"] = dict(config.features_extractor_kwargs)
+    lr: Any = config.learning_rate
+    if config.lr_schedule == "linear":
+        lr0 = config.learning_rate
+
+        def lr(progress_remaining: float) -> float:  # SB3: 1 at the start, 0 at the end
+            return lr0 * progress_remaining
+
+    return _algo_class(config.algo)(
+        config.policy, env, learning_rate=lr, n_steps=config.n_steps,
+        batch_size=config.batch_size, n_epochs=config.n_epochs, gamma=config.gamma,
+        gae_lambda=config.gae_lambda, clip_range=config.clip_range, ent_coef=config.ent_coef,
+        vf_coef=config.vf_coef, max_grad_norm=config.max_grad_norm,
+        policy_kwargs=policy_kwargs, tensorboard_log=tensorboard_log, seed=config.seed,
+        device=config.device, verbose=0)
+
+
+def _callbacks(config: TrainConfig, run_dir: Path, card_base: dict[str, Any],
+               progress: bool, wall_before: float, t0: float) -> Any:
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.logger import HParam
+
+    class Periodic(BaseCallback):
+        """Progress bar, periodic evaluation against the optimum, checkpoints, best model."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.eval_env = make_env(config.env_id, config.env_kwargs, config.wrappers)
+            self.refs = ReferenceGaits()
+            self.evaluations: list[dict[str, Any]] = []
+            path = run_dir / "evaluations.json"
+            if path.is_file():  # resumed run: keep the earlier evaluations
+                self.evaluations = json.loads(path.read_text(encoding="utf-8"))
+            self.best: tuple[float, float] | None = None
+            self.last: dict[str, Any] = {}
+            self.bar = None
+
+        def card(self, steps: int) -> dict[str, Any]:
+            return {**card_base, "steps": steps,
+                    "wall_s": wall_before + time.perf_counter() - t0,
+                    "eval": self.last or None}
+
+        def _on_training_start(self) -> None:
+            n = self.model.num_timesteps
+            self.next_eval = (n // config.eval_freq + 1) * config.eval_freq \
+                if config.eval_freq else None
+            self.next_ckpt = (n // config.checkpoint_freq + 1) * config.checkpoint_freq \
+                if config.checkpoint_freq else None
+            self.bar = tqdm(total=config.total_timesteps, initial=n, desc=config.name,
+                            unit="step", disable=not progress, dynamic_ncols=True)
+            hp = {k: (v if isinstance(v, (int, float, str, bool)) else json.dumps(v))
+                  for k, v in config.to_dict().items() if v is not None}
+            self.logger.record("hparams", HParam(hp, {"eval/success_rate": 0.0,
+                                                      "eval/regrasps_vs_optimal": 0.0}),
+                               exclude=("stdout", "log", "json", "csv"))
+
+        def evaluate(self) -> dict[str, Any]:
+            predict = agent_predictor(self.model, deterministic=True)
+            records = run_episodes(predict, self.eval_env, config.eval_episodes, EVAL_SEED,
+                                   self.refs)
+            summ = summarize_episodes(records)
+            steps = int(self.model.num_timesteps)
+            self.last = {"steps": steps, **summ}
+            self.evaluations.append(self.last)
+            write_text_atomic(run_dir / "evaluations.json",
+                              json.dumps(self.evaluations, indent=1) + "\n")
+            for key in ("success_rate", "success_rate_solvable", "mean_regrasps",
+                        "mean_optimal_regrasps", "regrasps_vs_optimal", "mean_rule_regrasps",
+                        "regrasps_vs_rule", "illegal_action_rate"):
+                if summ[key] is not None:
+                    self.logger.record(f"eval/{key}", summ[key])
+            self.logger.dump(steps)
+            rate = summ["success_rate_solvable"] or 0.0
+            score = (rate, -(summ["regrasps_vs_optimal"] or float("inf")))
+            if self.best is None or score > self.best:
+                self.best = score
+                save_agent(self.model, run_dir / "best.zip", self.card(steps))
+            if self.bar is not None:
+                self.bar.set_postfix(success=f"{rate:.0%}",
+                                     vs_opt=f"{summ['regrasps_vs_optimal'] or 0:.2f}")
+            return self.last
+
+        def _on_step(self) -> bool:
+            n = self.model.num_timesteps
+            if self.bar is not None:  # the last rollout may overshoot the total
+                self.bar.update(min(n, config.total_timesteps) - self.bar.n)
+            if self.next_ckpt is not None and n >= self.next_ckpt:
+                self.next_ckpt += config.checkpoint_freq
+                save_agent(self.model, run_dir / "checkpoints" / f"model_{n}_steps.zip",
+                           self.card(n))
+            if self.next_eval is not None and n >= self.next_eval:
+                self.next_eval += config.eval_freq
+                self.evaluate()
+            return True
+
+        def close(self) -> None:
+            if self.bar is not None:
+                self.bar.close()
+            self.eval_env.close()
+
+    return Periodic()
+
+
+def _resume_dir(checkpoint: Path) -> Path:
+    """The run folder of a checkpoint (``RUN/checkpoints/x.zip`` -> ``RUN``; else its folder)."""
+    parent = checkpoint.resolve().parent
+    return parent.parent if parent.name == "checkpoints" else parent
+
+
+def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
+          resume: str | os.PathLike[str] | None = None, progress: bool = True) -> TrainResult:
+    """Train an agent as ``config`` says; save it with its card; return where and how well.
+
+    Parameters
+    ----------
+    config
+        The hyper-parameters (:func:`agents.config.load_train_config`).
+    run_dir
+        The run's folder; default a new one under ``config.run_root`` named by
+        :func:`run_name` (or, with ``resume``, the checkpoint's run folder).
+    resume
+        A checkpoint ``.zip`` (``RUN/checkpoints/model_N_steps.zip``, or any model
+        saved by this module): training continues from its weights, optimizer state and
+        step count up to ``config.total_timesteps``. The environments restart from fresh
+        episodes, so a resumed run is not bit-identical to an uninterrupted one.
+    progress
+        Show a tqdm progress bar.
+
+    Returns
+    -------
+    TrainResult
+
+    Raises
+    ------
+    GraspGaitInputError
+        Bad env keywords, a missing checkpoint, or a checkpoint of another algorithm or
+        observation size.
+    """
+    set_torch_threads(config.torch_threads)
+    seed_everything(config.seed)
+    wall_before = 0.0
+    ckpt: Path | None = None
+    if resume is not None:
+        ckpt = Path(resume)
+        if not ckpt.is_file():
+            raise GraspGaitInputError(f"--resume {str(resume)!r}: no such checkpoint; give a "
+                                      "RUN/checkpoints/model_N_steps.zip")
+        card = read_card(ckpt)
+        if card.get("algo") not in (None, config.algo):
+            raise GraspGaitInputError(f"--resume {str(resume)!r}: a {card['algo']} model, the "
+                                      f"config trains {config.algo}; resume with its config")
+        wall_before = float(card.get("wall_s") or 0.0)
+        done = int(card.get("steps") or 0)
+        if done >= config.total_timesteps:
+            raise GraspGaitInputError(
+                f"--resume {str(resume)!r}: already trained {done} steps, total_timesteps is "
+                f"{config.total_timesteps}; raise it, e.g. --set total_timesteps={2 * done}")
+    env = make_vec_env_for(config)
+    run = Path(run_dir) if run_dir is not None else (
+        _resume_dir(ckpt) if ckpt is not None else _new_run_dir(config))
+    run.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(run / "config.yaml", yaml.safe_dump(config.to_dict(), sort_keys=False))
+    tb = str(run / "tb")
+    if ckpt is not None:
+        model = _algo_class(config.algo).load(ckpt, env=env, device=config.device,
+                                              tensorboard_log=tb)
+    else:
+        model = build_model(config, env, tensorboard_log=tb)
+    probe = make_env(config.env_id, config.env_kwargs, config.wrappers)
+    contact_model = contact_model_of(probe)
+    probe.close()
+    card_base = {"algo": config.algo, "env_id": config.env_id,
+                 "env_kwargs": dict(config.env_kwargs), "wrappers": list(config.wrappers),
+                 "contact_model": contact_model, "config": config.to_dict(),
+                 "seed": config.seed, "run_dir": str(run)}
+    t0 = time.perf_counter()
+    cb = _callbacks(config, run, card_base, progress, wall_before, t0)
+    try:
+        model.learn(total_timesteps=config.total_timesteps - int(model.num_timesteps),
+                    callback=cb, reset_num_timesteps=ckpt is None, tb_log_name="run")
+        if not cb.last or cb.last["steps"] != model.num_timesteps:
+            cb.evaluate()
+        steps = int(model.num_timesteps)
+        model_path = save_agent(model, run / "model.zip", cb.card(steps))
+    finally:
+        cb.close()
+        env.close()
+    return TrainResult(run_dir=run, model_path=model_path, steps=steps,
+                       wall_s=wall_before + time.perf_counter() - t0, last_eval=dict(cb.last))

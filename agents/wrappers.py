@@ -1,0 +1,202 @@
+"""Gymnasium wrappers for agents that cannot mask actions (plain PPO, RL Zoo, CleanRL)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["LegalActionWrapper", "SolvableStartWrapper", "legal_substitute"]
+
+
+def legal_substitute(action: int, mask: NDArray[np.bool_], group: NDArray[np.int64]) -> int:
+    """The legal action nearest to ``action`` in index, preferring its own group.
+
+    Parameters
+    ----------
+    action
+        The requested action index.
+    mask
+        Legal actions (bool, one per action).
+    group
+        Group of each action (see :class:`LegalActionWrapper`).
+
+    Returns
+    -------
+    int
+        ``action`` itself when legal; else the legal action of the same group with the
+        nearest index (ties: the lower index); else, when the group has no legal action,
+        the nearest legal action of any group; else (no legal action at all) ``action``.
+
+    Examples
+    --------
+    >>> mask = np.array([True, True, False, False, True, False])
+    >>> group = np.array([0, 0, 0, 1, 1, 1])
+    >>> legal_substitute(2, mask, group), legal_substitute(5, mask, group)
+    (1, 4)
+    >>> legal_substitute(3, np.zeros(6, bool), group)
+    3
+    """
+    if mask[action]:
+        return action
+    legal = np.flatnonzero(mask)
+    if legal.size == 0:
+        return action
+    same = legal[group[legal] == group[action]]
+    pool = same if same.size else legal
+    return int(pool[np.argmin(np.abs(pool - action))])
+
+
+class LegalActionWrapper(gym.Wrapper):
+    r"""Plays the nearest legal move in place of an illegal one, for agents without masks.
+
+    ## Description
+
+    A GraspGait env answers an illegal action with a penalized no-op; an agent that
+    cannot read the mask (SB3's plain PPO, RL Zoo, CleanRL, RLlib without action masking)
+    spends its episodes on them: plain PPO on ``GraspGait-v0`` stayed at 0% success for
+    200k steps, its episodes running to the 500-step limit (issue 11). This wrapper makes
+    every action a move: an illegal action is replaced by the legal action nearest to it
+    in the action layout, first within its own group:
+
+    | Group | Actions           | Meaning of "nearest"                                  |
+    |-------|-------------------|-------------------------------------------------------|
+    | 0     | ``0 .. R-1``      | the legal counter-clockwise rotation closest in size  |
+    | 1     | ``R .. 2R-1``     | the legal clockwise rotation closest in size          |
+    | 2     | ``2R + 2p``       | regrasp lifting the lower-numbered finger: the legal  |
+    |       |                   | one whose workspace position ``p`` is closest         |
+    | 3     | ``2R + 2p + 1``   | the same, lifting the higher-numbered finger          |
+
+    and, when the group has no legal action, the legal action nearest in index of any
+    group (:func:`legal_substitute`). So "rotate counter-clockwise by the most" becomes
+    the largest legal counter-clockwise rotation, and "regrasp at p" the nearest legal
+    regrasp point: the map from a wish to a move is fixed and part of the env's
+    dynamics, which PPO learns like any other. The legal moves are those of the wrapped
+    env's ``action_masks()`` (for ``GraspGaitMujoco-v0`` the estimate-based mask).
+
+    ## Action Space, Observation Space, Rewards
+
+    Those of the wrapped env, unchanged; the ``illegal`` reward term is therefore always
+    0 (no illegal move is ever played).
+
+    ## Info
+
+    The wrapped env's keys plus ``requested_action`` (what the agent asked for) and
+    ``action_substituted`` (True when it was illegal and replaced).
+
+    ## Arguments
+
+    ``LegalActionWrapper(env)``: a GraspGait env (any id; wrapped or not). RL Zoo:
+    ``env_wrapper: agents.wrappers.LegalActionWrapper`` (configs/rlzoo/ppo.yml).
+
+    ## Version History
+
+    - v0: initial version.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self._group: NDArray[np.int64] | None = None
+
+    def _groups(self) -> NDArray[np.int64]:
+        model = self.env.unwrapped.model
+        A, R = int(model.n_actions), int(model.R)
+        a = np.arange(A)
+        group = np.where(a < R, 0, np.where(a < 2 * R, 1, 2 + (a - 2 * R) % 2))
+        return group.astype(np.int64)
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset the wrapped env (the action layout is re-read: the hand may change)."""
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._group = self._groups()
+        return obs, info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Play ``action`` if legal, else its nearest legal substitute (class docstring)."""
+        if self._group is None:
+            return self.env.step(action)  # before reset: the env raises ResetNeededError
+        a = int(np.asarray(action).reshape(()))
+        if not 0 <= a < self._group.size:
+            return self.env.step(action)  # out of range: the env names the bad action
+        mask = self.env.unwrapped.action_masks()
+        played = legal_substitute(a, mask, self._group)
+        obs, reward, terminated, truncated, info = self.env.step(np.int64(played))
+        info["requested_action"] = a
+        info["action_substituted"] = played != a
+        return obs, reward, terminated, truncated, info
+
+
+_START_REDRAWS = 64  # resets tried before giving up on a start with a gait
+
+
+class SolvableStartWrapper(gym.Wrapper):
+    r"""Redraws the start grasp until a gait exists from it.
+
+    ## Description
+
+    ``GraspGait-v0`` draws its start grasp uniformly among the legal grasps at θ = 0
+    with a legal move, and from some of them no gait reaches the requested turn (on the
+    ellipse at mu 0.7, 165 of its 2289 starts; the exact planner proves it). Those episodes
+    can only fail, so a success rate over the env's own draws is capped below 100%
+    (with RL Zoo's ``enjoy`` and its seed 0, 6 of the first 42 starts of the ellipse
+    have no gait: at most 85.7%). This wrapper resets again (without a seed, so the
+    sequence stays a function of the first reset's seed) until the start has a gait,
+    so that success is measured, and trained for, over the starts from which a gait
+    exists: the measure ``graspgait evaluate`` reports as ``success_rate_solvable``.
+
+    A gait exists when the rule-based method (thesis 6.5, milliseconds) finds one, else
+    when the exact planner (:func:`graspgait_env.planners.exact.optimal_gait`) does; the
+    answers are cached per grasp map and start (:class:`agents.evaluate.ReferenceGaits`).
+
+    ## Action Space, Observation Space, Rewards, Episode End
+
+    Those of the wrapped env, unchanged.
+
+    ## Starting State
+
+    A start of the wrapped env from which a gait exists. ``reset(options={"start": ...})``
+    is kept as given (a chosen start is never replaced). After 64 draws without a gait,
+    ``RuntimeError`` names the object and ``mu``.
+
+    ## Info
+
+    The reset ``info`` of the wrapped env plus ``start_redraws`` (resets made beyond the
+    first).
+
+    ## Arguments
+
+    ``SolvableStartWrapper(env)``: a GraspGait env (any id). RL Zoo: listed under
+    ``env_wrapper`` (configs/rlzoo/ppo.yml).
+
+    ## Version History
+
+    - v0: initial version.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        from agents.evaluate import ReferenceGaits
+
+        self._refs = ReferenceGaits()
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset, then reset again until a gait exists from the start (class docstring)."""
+        obs, info = self.env.reset(seed=seed, options=options)
+        if options and "start" in options:
+            info["start_redraws"] = 0
+            return obs, info
+        u = self.env.unwrapped
+        turn = float(u.config.turn_deg)
+        for redraws in range(_START_REDRAWS):
+            if self._refs.gait_exists(u.model, u.state, turn):
+                info["start_redraws"] = redraws
+                return obs, info
+            obs, info = self.env.reset(options=options)
+        raise RuntimeError(
+            f"object {u.model.shape.name!r} at mu={u.model.mu:g}: {_START_REDRAWS} start "
+            f"grasps in a row had no gait turning it {turn:g} deg; raise mu or use "
+            "another object")

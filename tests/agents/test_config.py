@@ -1,0 +1,91 @@
+"""Training configs: bundled YAML, ``--set key=value`` overrides and their error messages."""
+
+from __future__ import annotations
+
+import pytest
+
+from agents.config import (
+    TrainConfig,
+    apply_overrides,
+    bundled_train_configs,
+    default_torch_threads,
+    load_train_config,
+    parse_override,
+)
+from graspgait_env.errors import GraspGaitInputError
+
+
+def test_bundled_configs_load_and_name_themselves():
+    names = bundled_train_configs()
+    assert {"circle", "ellipse", "pentagon", "hexagon", "random", "smoke"} <= set(names)
+    for name in names:
+        cfg = load_train_config(name)
+        assert cfg.name == name
+    for obj in ("circle", "ellipse", "pentagon", "hexagon"):
+        cfg = load_train_config(obj)
+        assert (cfg.algo, cfg.env_id, cfg.env_kwargs["object"], cfg.env_kwargs["mu"]) == (
+            "maskable_ppo", "GraspGait-v0", obj, 0.7)
+    assert load_train_config("random").env_id == "GraspGaitRandom-v0"
+
+
+def test_overrides_use_yaml_scalars_and_dotted_keys():
+    cfg = load_train_config("smoke", ["seed=3", "learning_rate=1e-3", "net_arch=[32, 16]",
+                                      "env_kwargs.object=pentagon", "env_kwargs.beta=0.05",
+                                      "features_extractor=null"])
+    assert cfg.seed == 3 and isinstance(cfg.seed, int)
+    assert cfg.learning_rate == pytest.approx(1e-3)
+    assert cfg.net_arch == [32, 16]
+    assert cfg.env_kwargs == {"object": "pentagon", "mu": 0.7, "beta": 0.05}
+    assert parse_override("env_kwargs.mu=0.8") == (["env_kwargs", "mu"], 0.8)
+    assert parse_override("name=abc") == (["name"], "abc")
+    # later overrides win; a nested dict is created when missing
+    assert apply_overrides({}, ["env_kwargs.mu=0.5", "env_kwargs.mu=0.6"]) == {
+        "env_kwargs": {"mu": 0.6}}
+
+
+def test_config_from_a_path(tmp_path):
+    p = tmp_path / "mine.yaml"
+    p.write_text("algo: ppo\nenv_kwargs: {object: circle, mu: 0.8}\ntotal_timesteps: 100\n"
+                 "batch_size: 32\n")
+    cfg = load_train_config(str(p))
+    assert (cfg.name, cfg.algo, cfg.total_timesteps) == ("mine", "ppo", 100)
+
+
+@pytest.mark.parametrize("overrides, match", [
+    (["n_steps=0"], r"n_steps=0: must be an integer >= 1, e.g. 256"),
+    (["algo=ppo2"], r"algo='ppo2': did you mean 'ppo'\?"),
+    (["seeed=1"], r"'seeed': not a training config field; did you mean 'seed'\?"),
+    (["seed"], r"--set 'seed': give key=value"),
+    (["seed=-1"], r"seed=-1: must be an integer >= 0"),
+    (["learning_rate=abc"], r"learning_rate='abc': must be a finite number > 0"),
+    (["batch_size=5000"], r"batch_size=5000: larger than a rollout \(n_envs \* n_steps = "),
+    (["net_arch=64"], r"net_arch=64: give a list of layer widths"),
+    (["env_id=CartPole-v1"], r"env_id='CartPole-v1': must be one of 'GraspGait-v0'"),
+    (["vec_env=batch"], r"vec_env='batch': .*must be one of 'dummy', 'subproc'"),
+    (["env_kwargs=3", "env_kwargs.mu=0.7"], r"env_kwargs is 3, not a mapping"),
+    (["net_arch=[64"], r"the value is not valid YAML"),
+    (["wrappers=[nodots]"], r"wrappers\[0\]='nodots': give an import path"),
+])
+def test_bad_overrides_name_the_field_and_the_fix(overrides, match):
+    with pytest.raises(GraspGaitInputError, match=match):
+        load_train_config("ellipse", overrides)
+
+
+def test_bad_config_files(tmp_path):
+    with pytest.raises(GraspGaitInputError, match=r"CONFIG 'nope': no such file and not a "
+                       r"bundled training config; use one of .*ellipse"):
+        load_train_config("nope")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("total_timestep: 10\n")
+    with pytest.raises(GraspGaitInputError, match=r"'total_timestep': not a training config "
+                       r"field; did you mean 'total_timesteps'\?"):
+        load_train_config(str(bad))
+    bad.write_text("- 1\n- 2\n")
+    with pytest.raises(GraspGaitInputError, match=r"must be a mapping of training config"):
+        load_train_config(str(bad))
+
+
+def test_torch_threads_follow_the_machine():
+    assert [default_torch_threads(c) for c in (1, 2, 4, 8, 16, 64)] == [1, 1, 1, 2, 4, 4]
+    assert TrainConfig().torch_threads == default_torch_threads()
+    assert TrainConfig(torch_threads=3).torch_threads == 3

@@ -1,0 +1,129 @@
+"""Training: a smoke run at a tiny budget, run folders, cards, checkpoints, resume, seeding."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+from agents.card import load_agent, read_card, save_agent
+from agents.config import load_train_config
+from agents.train import build_model, make_vec_env_for, train
+from graspgait_env.errors import GraspGaitInputError
+
+
+def test_smoke_run_writes_a_complete_run_folder(smoke_run):
+    run = smoke_run.run_dir
+    assert re.fullmatch(r"GraspGait-v0-smoke-s0-\d{8}-\d{6}(-\d+)?", run.name)
+    assert smoke_run.model_path == run / "model.zip"
+    assert smoke_run.steps == 256
+    for name in ("config.yaml", "model.zip", "model.json", "best.zip", "best.json",
+                 "evaluations.json", "checkpoints/model_128_steps.zip",
+                 "checkpoints/model_128_steps.json", "checkpoints/model_256_steps.zip"):
+        assert (run / name).is_file(), name
+    assert list((run / "tb").rglob("events.out.tfevents.*"))
+    card = read_card(run / "model.zip")
+    assert card["format"] == "graspgait-model-card/1"
+    assert (card["algo"], card["env_id"], card["seed"], card["steps"]) == (
+        "maskable_ppo", "GraspGait-v0", 0, 256)
+    assert card["env_kwargs"] == {"object": "ellipse", "mu": 0.7}
+    assert card["contact_model"] == "point"
+    assert card["config"]["name"] == "smoke" and card["config"]["n_envs"] == 2
+    assert 0 < card["wall_s"] < 120
+    assert set(card["versions"]) >= {"torch", "stable_baselines3", "sb3_contrib"}
+    evals = json.loads((run / "evaluations.json").read_text())
+    assert [e["steps"] for e in evals] == [128, 256]  # every eval_freq steps, and the end
+    assert smoke_run.last_eval == evals[-1]
+    assert smoke_run.last_eval["n_episodes"] == 3
+
+
+def _observations(n: int = 16):
+    env = gym.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7)
+    out = []
+    obs, info = env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    for i in range(n):
+        out.append((obs, info["action_mask"]))
+        legal = np.flatnonzero(info["action_mask"])
+        obs, _, term, trunc, info = env.step(np.int64(rng.choice(legal)))
+        if term or trunc:
+            obs, info = env.reset(seed=i + 1)
+    return out
+
+
+def test_save_and_load_give_identical_deterministic_actions(tmp_path):
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    model.learn(128)
+    path = save_agent(model, tmp_path / "m.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
+    loaded, card = load_agent(path)
+    assert card["algo"] == "maskable_ppo"
+    for obs, mask in _observations():
+        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
+        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
+        assert int(a0) == int(a1) and mask[int(a1)]
+    for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
+        assert torch.equal(p, q)
+
+
+def _params(path):
+    model, _ = load_agent(path)
+    return [p.detach().clone() for p in model.policy.parameters()]
+
+
+def test_same_seed_gives_identical_training_on_cpu(tmp_path, smoke_run):
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", "checkpoint_freq=0"])
+    again = train(cfg, progress=False)
+    for p, q in zip(_params(smoke_run.model_path), _params(again.model_path), strict=True):
+        assert torch.equal(p, q)
+    first = json.loads((smoke_run.run_dir / "evaluations.json").read_text())
+    second = json.loads((again.run_dir / "evaluations.json").read_text())
+    strip = lambda evals: [{k: v for k, v in e.items() if "wall" not in k} for e in evals]  # noqa: E731
+    assert strip(first) == strip(second)
+    other = train(load_train_config("smoke", [f"run_root={tmp_path}", "seed=1",
+                                              "checkpoint_freq=0", "eval_freq=0"]),
+                  progress=False)
+    assert not all(torch.equal(p, q) for p, q in
+                   zip(_params(smoke_run.model_path), _params(other.model_path), strict=True))
+
+
+def test_resume_continues_the_run_from_a_checkpoint(tmp_path, smoke_run):
+    ckpt = smoke_run.run_dir / "checkpoints" / "model_128_steps.zip"
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", "total_timesteps=384",
+                                      "eval_freq=0", "checkpoint_freq=0"])
+    out = tmp_path / "resumed"
+    res = train(cfg, run_dir=out, resume=ckpt, progress=False)
+    assert res.steps == 384
+    card = read_card(res.model_path)
+    assert card["steps"] == 384
+    assert card["wall_s"] >= read_card(ckpt)["wall_s"]
+    with pytest.raises(GraspGaitInputError, match=r"--resume .*already trained 256 steps, "
+                       r"total_timesteps is 256; raise it"):
+        train(load_train_config("smoke", [f"run_root={tmp_path}"]),
+              resume=smoke_run.run_dir / "checkpoints" / "model_256_steps.zip", progress=False)
+    with pytest.raises(GraspGaitInputError, match=r"--resume 'nope.zip': no such checkpoint"):
+        train(cfg, resume="nope.zip", progress=False)
+
+
+def test_plain_ppo_with_the_legal_action_wrapper_trains(tmp_path):
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", "algo=ppo", "eval_freq=0",
+                                      "checkpoint_freq=0",
+                                      "wrappers=[agents.wrappers.LegalActionWrapper]"])
+    res = train(cfg, progress=False)
+    card = read_card(res.model_path)
+    assert card["algo"] == "ppo" and card["wrappers"] == ["agents.wrappers.LegalActionWrapper"]
+    assert res.last_eval["illegal_action_rate"] is not None
+    model, _ = load_agent(res.model_path)
+    assert type(model).__name__ == "PPO"
+
+
+def test_bad_env_keywords_fail_before_training(tmp_path):
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", "env_kwargs.mu=-1"])
+    with pytest.raises(GraspGaitInputError, match=r"mu=-1"):
+        train(cfg, progress=False)
+    assert not list(tmp_path.iterdir())  # no run folder left behind
