@@ -27,7 +27,7 @@ demo: $(STAMP)
 	@echo "==> stable fraction of the grasp map against eccentricity and friction (thesis figs. 3.8-3.9)"
 	$(BIN)/graspgait sweep eccentricity --png out/sweep_eccentricity.png
 	@echo "==> the fewest-regrasp gait of the pentagon from the thesis's start (fig. 4.6), and the rule-based one"
-	$(BIN)/graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270 \
+	$(BIN)/graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270 --point-contacts \
 		--json out/pentagon_plan.json --motion out/pentagon_motion.txt --png out/pentagon_gait.png
 	$(BIN)/graspgait plan pentagon --mu 0.7 --planner rule \
 		--json out/pentagon_rule_plan.json --png out/pentagon_rule_gait.png

@@ -248,8 +248,9 @@ def tell_story(model_path: str | os.PathLike[str], out_dir: str | os.PathLike[st
     out.mkdir(parents=True, exist_ok=True)
     stem = prefix or model.shape.name
     start_deg = {str(f + 1): model.contact_deg(first.contacts[f]) for f in first.held()}
-    title = (f"{model.shape.name}, mu = {model.mu:g}: three gaits turning the object 360 deg "
-             f"from the start {start_deg}")
+    contacts = getattr(getattr(model, "contact_model", None), "name", "point")
+    title = (f"{model.shape.name}, mu = {model.mu:g}, {contacts} contacts: three gaits turning "
+             f"the object 360 deg from the start {start_deg}")
     files = {"figure": out / f"{stem}_story.png", "table": out / f"{stem}_story.md"}
     save_figure(story_figure(model, plans, rows, title), files["figure"])
     write_text_atomic(files["table"], f"{title}\n\n{table}\n")

@@ -423,7 +423,24 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         infos: dict[str, Any] = {}
         self._reset_subs(idx, [seeds[i] for i in idx], opts or None, infos)
         self._started = True
-        return (self._obs.copy() if self.copy else self._obs), infos
+        return self._observation(), infos
+
+    def _observation(self) -> NDArray[np.float32]:
+        """The batch's observation: header, mask and (kept in ``_obs``) windows and lines.
+
+        With ``copy`` a fresh array is assembled from the three parts (the header and mask
+        go straight into it); without, they are written into ``_obs``, which is returned.
+        """
+        o, mask_cols = self._obs, self.layout.mask
+        if not self.copy:
+            o[:, :_HEADER] = self._head
+            o[:, mask_cols] = self._mask
+            return o
+        out = np.empty_like(o)
+        out[:, :_HEADER] = self._head
+        out[:, mask_cols] = self._mask
+        out[:, mask_cols.stop:] = o[:, mask_cols.stop:]
+        return out
 
     # ------------------------------------------------------------------ step
     def _check_actions(self, actions: Any) -> NDArray[np.int64]:
@@ -542,8 +559,6 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         hd[:, _POS:_POS + 3] = np.where(p >= 0, p * self._inv_w, -1.0)
         ki = k - self._k_lo  # rows of the per-k tables
         hd[:, _THETA:_TO_GO + 1] = self._k_head.take(ki, axis=0)
-        o[:, :_HEADER] = hd
-        o[:, self.layout.mask] = mask
         if self._lines is not None:  # thesis 4.3: the regrasps keeping f or g
             shift = -k % n
             lines = o[:, self.layout.lines].reshape(N, 2, n)
@@ -587,7 +602,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         infos["is_success"], infos["_is_success"] = is_success, on
         infos["turn_deg"], infos["_turn_deg"] = k * self._step_deg, on
         infos["regrasps"], infos["_regrasps"] = self._regrasps.copy(), on
-        obs = o.copy() if self.copy else o
+        obs = self._observation()
         return obs, reward, terminated, truncated, infos
 
     def close_extras(self, **kwargs: Any) -> None:
