@@ -142,7 +142,7 @@ class TrainConfig:
     """``maskable_ppo`` (sb3-contrib MaskablePPO, legal actions only) or ``ppo`` (SB3 PPO)."""
     env_id: str = "GraspGait-v0"
     """A registered GraspGait id: ``GraspGait-v0``, ``GraspGaitRandom-v0`` or
-    ``GraspGaitMujoco-v0``."""
+    ``GraspGaitMujoco-v1``."""
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     """Keyword arguments of ``gymnasium.make(env_id, ...)``: ``object``, ``mu``,
     ``contact_model``, the GraspGaitConfig fields (reward weights, map window, ...)."""

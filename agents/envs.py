@@ -16,7 +16,7 @@ __all__ = ["import_object", "make_env", "env_kwargs_for", "contact_model_of"]
 
 # keyword arguments only GraspGaitRandom-v0 takes (it draws object and mu itself)
 RANDOM_ONLY = ("level", "mu_range", "object_seeds", "exclude_seeds", "bundled_fraction")
-# keyword arguments only GraspGaitMujoco-v0 takes
+# keyword arguments only GraspGaitMujoco-v1 takes
 MUJOCO_ONLY = ("sim_config", "pose_noise")
 
 
@@ -46,7 +46,7 @@ def make_env(env_id: str, env_kwargs: Mapping[str, Any] | None = None,
     Parameters
     ----------
     env_id
-        A GraspGait id (``GraspGait-v0``, ``GraspGaitRandom-v0``, ``GraspGaitMujoco-v0``).
+        A GraspGait id (``GraspGait-v0``, ``GraspGaitRandom-v0``, ``GraspGaitMujoco-v1``).
     env_kwargs
         Its keyword arguments (checked by the env: a bad one raises
         :class:`~graspgait_env.errors.GraspGaitInputError` naming it).
@@ -75,11 +75,11 @@ def env_kwargs_for(env_id: str, trained_id: str, trained_kwargs: Mapping[str, An
     The GraspGaitConfig fields (hand, grid, rewards, map window) and ``contact_model``
     carry over unchanged, so the observation means what it meant in training; the
     trained env's ``contact_model`` (the model card's) is passed explicitly when the
-    keywords do not name one, since ids differ in their default (``GraspGaitMujoco-v0``
+    keywords do not name one, since ids differ in their default (``GraspGaitMujoco-v1``
     plans for the hand, the others for point contacts). Keywords
     of the training id that ``env_id`` does not take are dropped
     (``GraspGaitRandom-v0``'s ``level``, ``mu_range``, ... when evaluating on one object;
-    ``GraspGaitMujoco-v0``'s ``sim_config``, ``pose_noise`` elsewhere). ``object`` and
+    ``GraspGaitMujoco-v1``'s ``sim_config``, ``pose_noise`` elsewhere). ``object`` and
     ``mu``, when given, replace the trained ones (refused for ``GraspGaitRandom-v0``,
     which draws both at every reset).
 
@@ -91,14 +91,14 @@ def env_kwargs_for(env_id: str, trained_id: str, trained_kwargs: Mapping[str, An
     kw = dict(trained_kwargs)
     if env_id != trained_id:
         drop = (RANDOM_ONLY if trained_id == "GraspGaitRandom-v0" else ()) + (
-            MUJOCO_ONLY if trained_id == "GraspGaitMujoco-v0" else ())
+            MUJOCO_ONLY if trained_id == "GraspGaitMujoco-v1" else ())
         if env_id == "GraspGaitRandom-v0":
             drop = drop + ("object", "mu")
         kw = {k: v for k, v in kw.items() if k not in drop}
     if env_id == "GraspGaitRandom-v0" and (object is not None or mu is not None):
         raise GraspGaitInputError(
             f"--object/--mu with --env {env_id}: it draws the object and mu at every reset; "
-            "use --env GraspGait-v0 (or GraspGaitMujoco-v0) to evaluate on one object")
+            "use --env GraspGait-v0 (or GraspGaitMujoco-v1) to evaluate on one object")
     if object is not None:
         kw["object"] = object
     if mu is not None:

@@ -74,7 +74,7 @@ class LegalActionWrapper(gym.Wrapper):
     the largest legal counter-clockwise rotation, and "regrasp at p" the nearest legal
     regrasp point: the map from a wish to a move is fixed and part of the env's
     dynamics, which PPO learns like any other. The legal moves are those of the wrapped
-    env's ``action_masks()`` (for ``GraspGaitMujoco-v0`` the estimate-based mask).
+    env's ``action_masks()`` (for ``GraspGaitMujoco-v1`` the estimate-based mask).
 
     ## Action Space, Observation Space, Rewards
 

@@ -720,7 +720,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", metavar="MODEL", help="a model zip (runs/<run>/model.zip, "
                    "agents/models/ellipse.zip)")
     p.add_argument("--env", metavar="ID", help="GraspGait-v0, GraspGaitRandom-v0 or "
-                   "GraspGaitMujoco-v0 (default: the training env)")
+                   "GraspGaitMujoco-v1 (default: the training env)")
     p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
     p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
     p.add_argument("--episodes", type=int, default=100, help="episodes (default 100)")

@@ -5,7 +5,7 @@ Ids (registered by :func:`register_envs`, which ``import graspgait_env`` calls):
 - ``GraspGait-v0`` (:class:`GraspGaitEnv`): one object, set by keyword arguments.
 - ``GraspGaitRandom-v0`` (:class:`GraspGaitRandomEnv`): a new object and friction at
   every reset, by difficulty level.
-- ``GraspGaitMujoco-v0`` (:class:`GraspGaitMujocoEnv`): the same spaces, each move
+- ``GraspGaitMujoco-v1`` (:class:`GraspGaitMujocoEnv`): the same spaces, each move
   executed on the MuJoCo hand by the thesis controller (ch. 7).
 
 The keyword arguments the three ids share are one frozen dataclass,

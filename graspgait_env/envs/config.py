@@ -1,7 +1,7 @@
 """The keyword arguments of the GraspGait env family: one frozen, validated dataclass.
 
 :class:`GraspGaitConfig` holds what every id (``GraspGait-v0``, ``GraspGaitRandom-v0``,
-``GraspGaitMujoco-v0``) shares: the hand and grid, the requested turn, the reward
+``GraspGaitMujoco-v1``) shares: the hand and grid, the requested turn, the reward
 weights, the wrong-way limit and the grasp-map window. Each env takes it as
 ``config=`` and, on top of it, any of its fields as a keyword argument, so
 ``gymnasium.make("graspgait_env:GraspGait-v0", beta=0.05)`` and
@@ -239,7 +239,7 @@ class GraspGaitConfig:
     """What the fingertips are in the grasp map (:mod:`graspgait_env.contact_model`):
     ``"point"``, the thesis's point contacts (``GraspGait-v0``'s default); ``"hand"``, the
     simulated hand's rolling ball tips with the friction margin its rotations need, so
-    that what is learned on the map runs on the hand (``GraspGaitMujoco-v0``'s
+    that what is learned on the map runs on the hand (``GraspGaitMujoco-v1``'s
     default)."""
 
     def __post_init__(self) -> None:

@@ -234,7 +234,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     r rotations) paid step by step, plus episode-end terms. Each step's terms are in
     ``info["reward_terms"]`` (a dict, always all six keys, in this order) and the reward
     is their sum, computed in this order (so ``reward == sum(terms.values())`` exactly),
-    by one method, ``_reward``, which ``GraspGaitMujoco-v0`` shares:
+    by one method, ``_reward``, which ``GraspGaitMujoco-v1`` shares:
 
     | Term        | Value                                                                     |
     |-------------|---------------------------------------------------------------------------|

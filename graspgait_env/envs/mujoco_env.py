@@ -1,4 +1,4 @@
-"""``GraspGaitMujoco-v0``: the grasp-gait env with every move executed in MuJoCo (thesis ch. 7).
+"""``GraspGaitMujoco-v1``: the grasp-gait env with every move executed in MuJoCo (thesis ch. 7).
 
 :class:`GraspGaitMujocoEnv` is :class:`~graspgait_env.envs.map_env.GraspGaitEnv` (same
 spaces, observation layout, reward terms and mask function) whose legal actions are
@@ -127,7 +127,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     ## Arguments
 
-    ``gymnasium.make("graspgait_env:GraspGaitMujoco-v0", object="ellipse", mu=0.7, *,
+    ``gymnasium.make("graspgait_env:GraspGaitMujoco-v1", object="ellipse", mu=0.7, *,
     sim_config=None, pose_noise=(0.0, 0.0), config=None, render_mode=None, **fields)``
 
     - ``object, mu, config, render_mode`` and the ``fields`` of
@@ -167,6 +167,11 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
 
     ## Version History
 
+    - v1: plans and acts with the hand's contact model (``contact_model="hand"``:
+      fingertip radius, load-torque friction margin, vertex clearance, rolling drift),
+      the sim's finger friction equals ``mu`` (was 1.0), the controller's check cone is
+      narrowed by the hand's margin and the fingers follow their rolling balls; renders
+      the hand from a camera above with overlays (was the map-level picture).
     - v0: initial version.
     """
 

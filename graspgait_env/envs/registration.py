@@ -16,7 +16,7 @@ MAX_EPISODE_STEPS = 500  # (steps) time limit of every id; a thesis gait needs 2
 ENV_IDS: dict[str, str] = {
     "GraspGait-v0": "graspgait_env.envs.map_env:GraspGaitEnv",
     "GraspGaitRandom-v0": "graspgait_env.envs.random_env:GraspGaitRandomEnv",
-    "GraspGaitMujoco-v0": "graspgait_env.envs.mujoco_env:GraspGaitMujocoEnv",
+    "GraspGaitMujoco-v1": "graspgait_env.envs.mujoco_env:GraspGaitMujocoEnv",
 }
 
 # id -> batched env: `gymnasium.make_vec(id, num_envs=N, vectorization_mode=

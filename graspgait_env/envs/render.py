@@ -46,7 +46,7 @@ __all__ = ["render_frame", "can_show", "GaitRenderer", "GaitFrames", "FINGER_COL
            "FRAME_SIZE"]
 
 FINGER_COLORS = ("tab:red", "tab:green", "tab:blue")  # fingers 1, 2, 3
-FRAME_SIZE = (640, 480)  # (px) width, height of a frame: GraspGaitMujoco-v0's size too
+FRAME_SIZE = (640, 480)  # (px) width, height of a frame: GraspGaitMujoco-v1's size too
 _DPI = 72
 _FIGSIZE = (FRAME_SIZE[0] / _DPI, FRAME_SIZE[1] / _DPI)  # (inches)
 _SPAN = 720.0  # (deg) the extended map's side

@@ -3,9 +3,9 @@
 Registered with :func:`graspgait_env.timing.register` once this module is listed in
 :data:`graspgait_env.perf.BENCHMARK_MODULES`. Targets (issue "a view of the hand"):
 
-- ``GraspGait-v0`` renders at least 20 frames/s, ``GraspGaitMujoco-v0`` at least 10,
+- ``GraspGait-v0`` renders at least 20 frames/s, ``GraspGaitMujoco-v1`` at least 10,
   both at 640 x 480 (their frame size), with the defaults a user gets;
-- ``GraspGaitMujoco-v0``'s masked random moves per second are reported (context, no
+- ``GraspGaitMujoco-v1``'s masked random moves per second are reported (context, no
   target: each move is a simulated physical move of the thesis controller).
 
 Frames: ``gymnasium.make(env_id, render_mode="rgb_array")``, masked random moves, one
@@ -29,7 +29,7 @@ __all__ = ["render_rate", "bench_render_rows", "MAP_FRAMES_PER_S_TARGET",
            "MUJOCO_FRAMES_PER_S_TARGET"]
 
 MAP_FRAMES_PER_S_TARGET = 20.0  # (frames/s) GraspGait-v0 at 640 x 480
-MUJOCO_FRAMES_PER_S_TARGET = 10.0  # (frames/s) GraspGaitMujoco-v0 at 640 x 480
+MUJOCO_FRAMES_PER_S_TARGET = 10.0  # (frames/s) GraspGaitMujoco-v1 at 640 x 480
 
 
 def render_rate(env_id: str, frames: int = 40, seed: int = 0, **kwargs: Any) -> dict[str, Any]:
@@ -85,7 +85,7 @@ def bench_render_rows(repeat: int) -> list[BenchRow]:
     rows = []
     for env_id, target, frames in (
             ("GraspGait-v0", MAP_FRAMES_PER_S_TARGET, max(10, round(60 * share))),
-            ("GraspGaitMujoco-v0", MUJOCO_FRAMES_PER_S_TARGET, max(10, round(30 * share)))):
+            ("GraspGaitMujoco-v1", MUJOCO_FRAMES_PER_S_TARGET, max(10, round(30 * share)))):
         r = render_rate(env_id, frames=frames)
         h, w = r["shape"][:2]
         rows.append(BenchRow(
@@ -94,9 +94,9 @@ def bench_render_rows(repeat: int) -> list[BenchRow]:
             f"render_mode='rgb_array', defaults, a render() after each of {frames} masked "
             f"random moves; first frame {r['first_frame_s']:.2f} s (not counted)"))
     moves = max(30, round(150 * share))
-    rate = graspgait_steps_per_s(steps=moves, seed=0, env_id="GraspGaitMujoco-v0")
+    rate = graspgait_steps_per_s(steps=moves, seed=0, env_id="GraspGaitMujoco-v1")
     rows.append(BenchRow(
-        "GraspGaitMujoco-v0 moves/s", rate, "moves/s", "", None,
+        "GraspGaitMujoco-v1 moves/s", rate, "moves/s", "", None,
         f"gymnasium.make, defaults, {moves} masked random moves with resets, each "
         "executed on the simulated hand"))
     return rows

@@ -428,19 +428,14 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     def _observation(self) -> NDArray[np.float32]:
         """The batch's observation: header, mask and (kept in ``_obs``) windows and lines.
 
-        With ``copy`` a fresh array is assembled from the three parts (the header and mask
-        go straight into it); without, they are written into ``_obs``, which is returned.
+        The header and mask are written into ``_obs``; with ``copy`` a copy of it is
+        returned (one contiguous copy), without, ``_obs`` itself.
         """
-        o, mask_cols = self._obs, self.layout.mask
-        if not self.copy:
-            o[:, :_HEADER] = self._head
-            o[:, mask_cols] = self._mask
-            return o
-        out = np.empty_like(o)
-        out[:, :_HEADER] = self._head
-        out[:, mask_cols] = self._mask
-        out[:, mask_cols.stop:] = o[:, mask_cols.stop:]
-        return out
+        o = self._obs
+        o[:, :_HEADER] = self._head
+        o[:, self.layout.mask] = self._mask
+        # one contiguous copy is cheaper than assembling a fresh array part by part
+        return o.copy() if self.copy else o
 
     # ------------------------------------------------------------------ step
     def _check_actions(self, actions: Any) -> NDArray[np.int64]:

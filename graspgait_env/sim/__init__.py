@@ -22,7 +22,7 @@
   the ``graspgait simulate`` command and its input checks;
 - :mod:`~graspgait_env.sim.view`: :class:`~graspgait_env.sim.view.HandView`, frames of
   the hand from above with the workspaces, finger numbers and captions overlaid (the
-  ``GraspGaitMujoco-v0`` frames and the videos).
+  ``GraspGaitMujoco-v1`` frames and the videos).
 
 Rendering is headless: ``MUJOCO_GL`` defaults to ``egl`` here, which takes effect only
 if MuJoCo has not been imported yet (the Makefile exports it too).

@@ -61,7 +61,7 @@ class VideoRecorder:
         Frame size (px).
     camera
         An MJCF camera name (``config.video_camera``); None: straight above, as
-        ``GraspGaitMujoco-v0`` renders.
+        ``GraspGaitMujoco-v1`` renders.
     plan
         The plan run, for the captions (object, friction, the turn asked for, move
         *i* of *n*); :attr:`move` is set by :func:`simulate_plan` before each step.

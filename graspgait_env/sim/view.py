@@ -30,7 +30,7 @@ without, the same load). The overlays are anti-aliased by their own rasterizer; 
 edges of the bodies are not.
 
 The GL context and MuJoCo's render context are kept across models whose MJCF is the
-same (``GraspGaitMujoco-v0`` builds a fresh model at every reset from the same MJCF),
+same (``GraspGaitMujoco-v1`` builds a fresh model at every reset from the same MJCF),
 so a reset does not cost a new context (~0.15 s each here).
 """
 

@@ -139,14 +139,14 @@ def test_env_keywords_carry_over_between_ids():
     assert env_kwargs_for("GraspGait-v0", "GraspGaitRandom-v0", trained, "pentagon", 0.7) == {
         "beta": 0.05, "object": "pentagon", "mu": 0.7}
     assert env_kwargs_for("GraspGaitRandom-v0", "GraspGaitRandom-v0", trained) == trained
-    assert env_kwargs_for("GraspGaitMujoco-v0", "GraspGait-v0",
+    assert env_kwargs_for("GraspGaitMujoco-v1", "GraspGait-v0",
                           {"object": "circle", "mu": 0.7, "contact_model": "hand"}) == {
         "object": "circle", "mu": 0.7, "contact_model": "hand"}
     assert env_kwargs_for("GraspGaitRandom-v0", "GraspGait-v0", {"object": "circle",
                                                                  "mu": 0.7, "beta": 0.1}) == {
         "beta": 0.1}
-    # the card's contact model is passed on (GraspGaitMujoco-v0 would default to "hand")
-    assert env_kwargs_for("GraspGaitMujoco-v0", "GraspGait-v0", {"object": "circle"},
+    # the card's contact model is passed on (GraspGaitMujoco-v1 would default to "hand")
+    assert env_kwargs_for("GraspGaitMujoco-v1", "GraspGait-v0", {"object": "circle"},
                           contact_model="point") == {"object": "circle",
                                                      "contact_model": "point"}
     assert env_kwargs_for("GraspGait-v0", "GraspGait-v0", {"contact_model": "hand"},
@@ -175,10 +175,10 @@ def test_evaluate_refuses_bad_input(smoke_run, tmp_path):
 def test_evaluate_on_the_mujoco_hand(smoke_run):
     # a 10-degree turn, 10 degrees of wrong way, a sampling policy (the untrained greedy
     # one may regrasp back and forth): an episode is a few moves of physics
-    res = evaluate(smoke_run.model_path, env_id="GraspGaitMujoco-v0", episodes=1,
+    res = evaluate(smoke_run.model_path, env_id="GraspGaitMujoco-v1", episodes=1,
                    deterministic=False,
                    env_overrides={"turn_deg": 10.0, "max_backward_deg": 10.0})
-    assert res["env_id"] == "GraspGaitMujoco-v0"
+    assert res["env_id"] == "GraspGaitMujoco-v1"
     assert res["contact_model"] == "point"  # the card's, not the Mujoco id's default
     (ep,) = res["episodes"]
     assert ep["steps"] < 500 and ep["illegal_actions"] == 0

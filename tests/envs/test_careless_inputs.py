@@ -21,7 +21,7 @@ from graspgait_env.gait import GaitState
 pytestmark = pytest.mark.filterwarnings("ignore:.*not in the possible render_modes")
 
 PREFIX = "graspgait_env.envs:"
-MAP, RANDOM, MUJOCO = "GraspGait-v0", "GraspGaitRandom-v0", "GraspGaitMujoco-v0"
+MAP, RANDOM, MUJOCO = "GraspGait-v0", "GraspGaitRandom-v0", "GraspGaitMujoco-v1"
 ALL_IDS = (MAP, RANDOM, MUJOCO)
 
 
@@ -79,7 +79,7 @@ BAD_KWARGS = [
     (MUJOCO, {"pose_noise": "big"}, ["pose_noise='big'", "thesis"]),
     (MUJOCO, {"pose_noise": (-1.0, 0.0)}, ["pose_noise[0]=-1.0", ">= 0"]),
     (MUJOCO, {"sim_config": 3}, ["sim_config=3", "SimConfig"]),
-    (MUJOCO, {"bogus": 1}, ["bogus=1", "GraspGaitMujoco-v0", "sim_config"]),
+    (MUJOCO, {"bogus": 1}, ["bogus=1", "GraspGaitMujoco-v1", "sim_config"]),
     (MUJOCO, {"illegal_penalty": -1}, ["illegal_penalty=-1", ">= 0"]),
 ]
 

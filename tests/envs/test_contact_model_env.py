@@ -1,6 +1,6 @@
 """The env family's ``contact_model`` kwarg: map-level envs learn on the maps the hand
 can execute (``"hand"``); ``GraspGait-v0`` keeps the thesis's point contacts by default
-and ``GraspGaitMujoco-v0`` plans with the hand's."""
+and ``GraspGaitMujoco-v1`` plans with the hand's."""
 
 from __future__ import annotations
 
@@ -38,11 +38,11 @@ def test_the_hand_model_follows_the_object_and_turn():
 
 
 def test_mujoco_env_plans_for_the_hand_at_finger_friction_mu():
-    env = gym.make("graspgait_env:GraspGaitMujoco-v0", object="circle", mu=0.7)
+    env = gym.make("graspgait_env:GraspGaitMujoco-v1", object="circle", mu=0.7)
     u = env.unwrapped
     assert u.config.contact_model == "hand" and u.model.contact_model.name == "hand"
     assert u.sim_config.finger_mu is None  # the contacts' friction is the plan's mu
-    point = gym.make("graspgait_env:GraspGaitMujoco-v0", object="circle", contact_model="point")
+    point = gym.make("graspgait_env:GraspGaitMujoco-v1", object="circle", contact_model="point")
     assert point.unwrapped.model.contact_model.is_point
 
 

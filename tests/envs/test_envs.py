@@ -35,10 +35,10 @@ WARNING_WHITELIST = ("cannot open a window (no display)",)
 # (id, kwargs) cases: every registered id, several objects for the fixed-object id
 CASES = [("GraspGait-v0", {"object": o}) for o in CHECK_OBJECTS] + [
     ("GraspGaitRandom-v0", {"level": lv}) for lv in (0, len(LEVELS) - 1)] + [
-    ("GraspGaitMujoco-v0", {"object": o}) for o in ("ellipse", "pentagon")]
+    ("GraspGaitMujoco-v1", {"object": o}) for o in ("ellipse", "pentagon")]
 assert {c[0] for c in CASES} == set(ENV_IDS)
 # the physics-level id costs ~30 ms a move: its full 20 x 200 rollout check is slow
-SLOW_IDS = {"GraspGaitMujoco-v0"}
+SLOW_IDS = {"GraspGaitMujoco-v1"}
 DETERMINISM_IDS = [pytest.param(i, marks=pytest.mark.slow) if i in SLOW_IDS else i
                    for i in sorted(ENV_IDS)]
 

@@ -1,4 +1,4 @@
-"""GraspGaitMujoco-v0: API conformance, determinism, pickling, drops, warnings, a full gait."""
+"""GraspGaitMujoco-v1: API conformance, determinism, pickling, drops, warnings, a full gait."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from graspgait_env.envs.map_env import REWARD_TERMS, state_from_observation
 from graspgait_env.envs.mujoco_env import MUJOCO_WARNINGS, GraspGaitMujocoEnv
 from graspgait_env.envs.registration import ENV_IDS, MAX_EPISODE_STEPS
 
-ENV_ID = "graspgait_env.envs:GraspGaitMujoco-v0"
+ENV_ID = "graspgait_env.envs:GraspGaitMujoco-v1"
 WARNING_WHITELIST = ("cannot open a window (no display)",)
 SIM_KEYS = ("dropped", "sim_status", "mujoco_warning", "pose_estimate", "estimated_turn_deg",
             "true_turn_deg", "mask_from_estimate", "sim_time_s")
@@ -43,8 +43,8 @@ def rollout(env: gym.Env, seed: int, steps: int, illegal_every: int = 0) -> list
 
 
 def test_registered():
-    assert ENV_IDS["GraspGaitMujoco-v0"] == "graspgait_env.envs.mujoco_env:GraspGaitMujocoEnv"
-    assert gym.spec("GraspGaitMujoco-v0").max_episode_steps == MAX_EPISODE_STEPS
+    assert ENV_IDS["GraspGaitMujoco-v1"] == "graspgait_env.envs.mujoco_env:GraspGaitMujocoEnv"
+    assert gym.spec("GraspGaitMujoco-v1").max_episode_steps == MAX_EPISODE_STEPS
 
 
 def test_same_spaces_as_map_env():

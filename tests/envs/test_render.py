@@ -81,7 +81,7 @@ def test_map_frame_shows_the_boxes_and_their_labels_at_theta():
 def test_mujoco_frame_is_the_hand_from_above_with_overlays():
     from graspgait_env.sim.view import FINGER_RGB
 
-    env = gym.make(PREFIX + "GraspGaitMujoco-v0", object="ellipse", render_mode="rgb_array")
+    env = gym.make(PREFIX + "GraspGaitMujoco-v1", object="ellipse", render_mode="rgb_array")
     env.reset(seed=0)
     u = env.unwrapped
     f = env.render()
@@ -145,7 +145,7 @@ def test_hand_view_projects_through_a_named_camera_and_refuses_bad_sizes():
 
 # ---------------------------------------------------------------------------- RecordVideo
 @pytest.mark.parametrize("env_id", ["GraspGait-v0",
-                                    pytest.param("GraspGaitMujoco-v0", marks=needs_gl)])
+                                    pytest.param("GraspGaitMujoco-v1", marks=needs_gl)])
 def test_record_video_writes_an_episode(env_id, tmp_path):
     import imageio_ffmpeg
     from gymnasium.wrappers import RecordVideo
@@ -169,7 +169,7 @@ def test_mujoco_env_renders_headless_with_nothing_set(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY",
                                                              "PYOPENGL_PLATFORM")}
     code = ("import gymnasium as gym; "
-            "e = gym.make('graspgait_env.envs:GraspGaitMujoco-v0', render_mode='rgb_array'); "
+            "e = gym.make('graspgait_env.envs:GraspGaitMujoco-v1', render_mode='rgb_array'); "
             "e.reset(seed=0); print(e.render().shape)")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, timeout=120, cwd=tmp_path)
@@ -188,7 +188,7 @@ def test_mujoco_human_mode_shows_the_hand_once_it_holds_the_object(monkeypatch):
     shown = []
     monkeypatch.setattr(render, "can_show", lambda: True)
     monkeypatch.setattr(plt, "pause", lambda s: shown.append(s))
-    env = gym.make(PREFIX + "GraspGaitMujoco-v0", object="circle", render_mode="human")
+    env = gym.make(PREFIX + "GraspGaitMujoco-v1", object="circle", render_mode="human")
     env.reset(seed=0)
     assert len(shown) == 1 and shown[0] == 1.0 / 4
     legal = np.flatnonzero(env.unwrapped.action_masks())
