@@ -10,6 +10,16 @@ trained with (its card), the object and ``mu`` of the cell, and plays greedily
 CSV, JSON and Table 1 carry the agents beside the planners; ``nodes_opened`` is 0 (an
 agent searches nothing) and ``path_length`` counts the moves made.
 
+Contact models: the planners' columns use the thesis's point contacts. An agent trained
+with another contact model (the hand's, ``contact_model: hand`` in its card) cannot be
+run from those starts (under the hand's maps some are not force-closure, at mu 0.8
+more), and its regrasps are not comparable with point-contact gaits. Such an agent runs
+from starts picked the bench's way (:func:`baselines.bench.bench_starts`) on its own
+env's gait model, and its case carries the optimum's and the rule-based gait's regrasps
+from the same start under the same contact model (``contact_model``,
+``optimal_regrasps``, ``rule_regrasps``; :class:`agents.evaluate.ReferenceGaits`); the
+ratios of :func:`agent_rows` use those.
+
 Which agent runs where: an agent trained on ``GraspGaitRandom-v0`` (a generalist, e.g.
 ``random.zip``) runs on every object; an agent trained on one object runs on that
 object only (at every ``mu`` of the bench).
@@ -115,33 +125,45 @@ def run_agent_bench(agents: Sequence[Agent], objects: Sequence[str] = THESIS_OBJ
                     mus: Sequence[float] = (0.8, 0.7), starts: int = 10,
                     turn_deg: float = 360.0, progress: bool = True) -> list[BenchCase]:
     """Run each agent from the bench's starts on each object and ``mu``; one row per run."""
+    from agents.evaluate import ReferenceGaits
+
     jobs = []
+    envs: dict[tuple[str, str, float], Any] = {}
     for obj in objects:
         for mu in mus:
             model = GaitModel(obj, mu)
             picked = bench_starts(model, starts)
             for agent in agents:
-                if agent.runs_on(obj):
-                    jobs.extend((obj, mu, agent, s, model) for s in picked)
+                if not agent.runs_on(obj):
+                    continue
+                kw = env_kwargs_for("GraspGait-v0", agent.card.get("env_id") or "GraspGait-v0",
+                                    agent.card.get("env_kwargs") or {}, obj, mu,
+                                    contact_model=agent.card.get("contact_model"))
+                kw["turn_deg"] = turn_deg
+                env = envs[(agent.name, obj, mu)] = make_env(
+                    "GraspGait-v0", kw, agent.card.get("wrappers") or ())
+                own = env.unwrapped.config.contact_model
+                if own == "point":  # the planners' starts and references
+                    jobs.extend((obj, mu, agent, s, model, None) for s in picked)
+                else:  # starts and references under the agent's own contact model
+                    env.reset(seed=0)
+                    own_model = env.unwrapped.model
+                    jobs.extend((obj, mu, agent, s, own_model, own)
+                                for s in bench_starts(own_model, starts))
+    refs = ReferenceGaits()
     cases: list[BenchCase] = []
-    envs: dict[tuple[str, str, float], Any] = {}
-    for obj, mu, agent, s, model in tqdm(jobs, desc="bench agents", disable=not progress,
-                                         unit="run"):
-        key = (agent.name, obj, mu)
-        if key not in envs:
-            kw = env_kwargs_for("GraspGait-v0", agent.card.get("env_id") or "GraspGait-v0",
-                                agent.card.get("env_kwargs") or {}, obj, mu,
-                                contact_model=agent.card.get("contact_model"))
-            kw["turn_deg"] = turn_deg
-            envs[key] = make_env("GraspGait-v0", kw, agent.card.get("wrappers") or ())
-        env = envs[key]
+    for obj, mu, agent, s, model, own in tqdm(jobs, desc="bench agents", disable=not progress,
+                                              unit="run"):
+        env = envs[(agent.name, obj, mu)]
         predict = agent_predictor(agent.model, deterministic=True)
         start = {f + 1: model.contact_deg(s.contacts[f]) for f in s.held()}
         ep = play_episode(predict, env, seed=0, options={"start": start})
         label = ",".join(f"{f}:{phi:g}" for f, phi in start.items())
+        opt, rule = refs.regrasps(model, s, turn_deg) if own is not None else (None, None)
         cases.append(BenchCase(obj, mu, label, f"agent:{agent.name}", ep["success"], 0,
                                ep["path_length"], ep["regrasps"], ep["turn_deg"], ep["wall_s"],
-                               ""))
+                               "", contact_model=own, optimal_regrasps=opt,
+                               rule_regrasps=rule))
     for env in envs.values():
         env.close()
     return cases
@@ -177,11 +199,16 @@ def agent_rows(cases: Sequence[BenchCase]) -> list[dict[str, Any]]:
                "regrasps_per_360": _mean([_per360(c) for c in ok]),
                "path_length": _mean([c.path_length for c in ok]),
                "wall_ms": 1e3 * _mean([c.wall_time_s for c in runs])}
+        row["contact_model"] = runs[0].contact_model or "point"
         for ref, col in (("optimal", "vs_optimal"), ("rule", "vs_rule")):
-            pairs = [(c, by_key.get((obj, mu, c.start, ref))) for c in ok]
-            pairs = [(c, r) for c, r in pairs if r is not None and r.success]
-            mine, theirs = _mean([c.regrasps for c, _ in pairs]), _mean([r.regrasps
-                                                                         for _, r in pairs])
+            if runs[0].contact_model is None:  # the point-contact planners' runs
+                pairs = [(c, by_key.get((obj, mu, c.start, ref))) for c in ok]
+                pairs = [(c.regrasps, r.regrasps) for c, r in pairs
+                         if r is not None and r.success]
+            else:  # the references under the agent's contact model, from its case
+                pairs = [(c.regrasps, getattr(c, f"{ref}_regrasps")) for c in ok]
+                pairs = [(a, b) for a, b in pairs if b is not None]
+            mine, theirs = _mean([a for a, _ in pairs]), _mean([b for _, b in pairs])
             row[col] = mine / theirs if pairs and theirs else math.nan
         rows.append(row)
     return rows
@@ -196,11 +223,12 @@ def agents_markdown(cases: Sequence[BenchCase], notes: Sequence[str] = ()) -> st
     lines = ["### Learned agents beside the optimum and the rule-based gait (same starts)", ""]
     rows = agent_rows(cases)
     if rows:
-        lines += ["| object | mu | agent | success | regrasps per 360° | x optimum | x rule-based "
-                  "| path length | wall time (ms) |",
-                  "|---|---|---|---:|---:|---:|---:|---:|---:|"]
+        lines += ["| object | mu | agent | contacts | success | regrasps per 360° | x optimum "
+                  "| x rule-based | path length | wall time (ms) |",
+                  "|---|---|---|---|---:|---:|---:|---:|---:|---:|"]
         for r in rows:
-            lines.append(f"| {r['object']} | {r['mu']:g} | {r['agent']} | {r['success']:.0%} | "
+            lines.append(f"| {r['object']} | {r['mu']:g} | {r['agent']} | "
+                         f"{r['contact_model']} | {r['success']:.0%} | "
                          f"{_f(r['regrasps_per_360'])} | {_f(r['vs_optimal'], '.2f')} | "
                          f"{_f(r['vs_rule'], '.2f')} | {_f(r['path_length'])} | "
                          f"{_f(r['wall_ms'])} |")

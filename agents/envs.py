@@ -15,7 +15,8 @@ from graspgait_env.errors import GraspGaitInputError
 __all__ = ["import_object", "make_env", "env_kwargs_for", "contact_model_of"]
 
 # keyword arguments only GraspGaitRandom-v0 takes (it draws object and mu itself)
-RANDOM_ONLY = ("level", "mu_range", "object_seeds", "exclude_seeds", "bundled_fraction")
+RANDOM_ONLY = ("level", "mu_range", "object_seeds", "exclude_seeds", "bundled_fraction",
+               "episodes_per_object")
 # keyword arguments only GraspGaitMujoco-v1 takes
 MUJOCO_ONLY = ("sim_config", "pose_noise")
 

@@ -71,6 +71,12 @@ class BenchCase:
     method: str = ""
     entry_needed: bool | None = None
     entry_moves: int | None = None
+    # an agent run under a contact model other than the bench's point contacts: the
+    # contact model and the optimum's and rule-based gait's regrasps from the same start
+    # under it (None for the planners' runs, compared with the point-contact planners)
+    contact_model: str | None = None
+    optimal_regrasps: int | None = None
+    rule_regrasps: int | None = None
 
 
 def bench_starts(model: GaitModel, count: int = 10) -> list[GaitState]:

@@ -38,7 +38,7 @@ def test_ratios_pair_the_same_starts():
     assert row["vs_optimal"] == pytest.approx(20 / 18)  # starts a and b
     assert row["vs_rule"] == pytest.approx(12 / 14)  # start a only: rule failed b
     md = agents_markdown(cases, ["agent y: not there yet; skipped"])
-    assert "| ellipse | 0.7 | x | 67% | 10.0 | 1.11 | 0.86 |" in md
+    assert "| ellipse | 0.7 | x | point | 67% | 10.0 | 1.11 | 0.86 |" in md
     assert md.endswith("- agent y: not there yet; skipped")
 
 
@@ -68,3 +68,41 @@ def test_agent_runs_from_the_bench_starts_and_plots(smoke_run, tmp_path):
         assert c.nodes_opened == 0 and c.path_length >= c.regrasps
     png = plot_bench(cases + [_case("optimal", cases[0].start, True, 10)], tmp_path / "b.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_an_agent_with_its_own_contact_model_is_compared_under_it():
+    """A hand-contact agent's ratios use the references its cases carry, not the
+    point-contact planners' runs from a start of the same name."""
+    own = [BenchCase("ellipse", 0.7, "a", "agent:h", True, 0, 20, 11, 360.0, 0.01, "",
+                     contact_model="hand", optimal_regrasps=10, rule_regrasps=11),
+           BenchCase("ellipse", 0.7, "b", "agent:h", True, 0, 20, 12, 360.0, 0.01, "",
+                     contact_model="hand", optimal_regrasps=10, rule_regrasps=16)]
+    point_refs = [_case("optimal", "a", True, 5), _case("rule", "a", True, 5)]
+    (row,) = agent_rows(own + point_refs)
+    assert row["contact_model"] == "hand"
+    assert row["vs_optimal"] == pytest.approx(23 / 20)
+    assert row["vs_rule"] == pytest.approx(23 / 27)
+    assert "| hand |" in agents_markdown(own + point_refs)
+
+
+@pytest.mark.skipif(not (find_agents("shipped")[0]), reason="no shipped model")
+def test_hand_agent_runs_from_starts_legal_under_its_contact_model():
+    """At mu 0.8 some point-contact bench starts are not force-closure for the hand; the
+    shipped ellipse agent (hand contacts) runs from its own model's starts, with the
+    optimum under the same model, which it never beats."""
+    agents, _ = find_agents("ellipse")
+    cases = run_agent_bench(agents, ["ellipse"], [0.8], starts=2, progress=False)
+    assert len(cases) == 2
+    for c in cases:
+        assert c.contact_model == "hand" and c.optimal_regrasps is not None
+        if c.success:
+            assert c.regrasps >= c.optimal_regrasps
+
+
+def test_a_generalists_random_env_keywords_are_dropped_for_one_object():
+    from agents.envs import env_kwargs_for
+
+    kw = env_kwargs_for("GraspGait-v0", "GraspGaitRandom-v0",
+                        {"level": 1, "episodes_per_object": 8, "beta": 0.03}, "ellipse", 0.7)
+    assert "episodes_per_object" not in kw and "level" not in kw
+    assert (kw["beta"], kw["object"], kw["mu"]) == (0.03, "ellipse", 0.7)
