@@ -238,11 +238,21 @@ def agents_markdown(cases: Sequence[BenchCase], notes: Sequence[str] = ()) -> st
     return "\n".join(lines)
 
 
+def _contacts_note(cases: Sequence[BenchCase], method: str) -> str:
+    """``", hand contacts"`` for an agent run under a contact model other than the
+    planners' point contacts (its bars come from its own starts and maps)."""
+    own = {c.contact_model for c in cases if c.planner == method} - {None, "point"}
+    return f", {'/'.join(sorted(own))} contacts" if own else ""
+
+
 def plot_bench(cases: Sequence[BenchCase], path: str | os.PathLike[str]) -> Path:
     """Bar chart of regrasps per 360° (successful runs) per object, ``mu`` and method.
 
     One panel per ``mu``; each method (planner or agent) a bar per object, labelled with
-    its success rate. Written atomically (PNG, SVG or PDF by the suffix).
+    its success rate. An agent run under the hand's contact model is labelled so: its
+    bars come from starts and grasp maps of that model, not the planners' point
+    contacts (compare it through the table's ratios). Written atomically (PNG, SVG or
+    PDF by the suffix).
     """
     from matplotlib.figure import Figure
 
@@ -265,7 +275,7 @@ def plot_bench(cases: Sequence[BenchCase], path: str | os.PathLike[str]) -> Path
                 ys.append(_mean([_per360(c) for c in ok]) if ok else 0.0)
                 labels.append(f"{len(ok) / len(runs):.0%}")
             bars = ax.bar(xs, ys, width, label=m.removeprefix("agent:") + (
-                " (agent)" if m.startswith("agent:") else ""))
+                f" (agent{_contacts_note(cases, m)})" if m.startswith("agent:") else ""))
             ax.bar_label(bars, labels=labels, fontsize=6, rotation=90, padding=2)
         ax.set_xticks(range(len(objs)), objs)
         ax.set_ylabel("regrasps per 360° (successful runs)")

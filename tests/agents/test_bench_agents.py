@@ -106,3 +106,14 @@ def test_a_generalists_random_env_keywords_are_dropped_for_one_object():
                         {"level": 1, "episodes_per_object": 8, "beta": 0.03}, "ellipse", 0.7)
     assert "episodes_per_object" not in kw and "level" not in kw
     assert (kw["beta"], kw["object"], kw["mu"]) == (0.03, "ellipse", 0.7)
+
+
+def test_plot_labels_an_agent_with_the_hands_contacts(tmp_path):
+    from agents.bench import _contacts_note
+
+    hand = BenchCase("ellipse", 0.7, "a", "agent:h", True, 0, 20, 11, 360.0, 0.01, "",
+                     contact_model="hand", optimal_regrasps=10, rule_regrasps=11)
+    cases = [hand, _case("agent:p", "a", True, 9), _case("optimal", "a", True, 8)]
+    assert _contacts_note(cases, "agent:h") == ", hand contacts"
+    assert _contacts_note(cases, "agent:p") == ""
+    assert plot_bench(cases, tmp_path / "b.png").stat().st_size > 0
