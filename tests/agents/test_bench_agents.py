@@ -117,3 +117,15 @@ def test_plot_labels_an_agent_with_the_hands_contacts(tmp_path):
     assert _contacts_note(cases, "agent:h") == ", hand contacts"
     assert _contacts_note(cases, "agent:p") == ""
     assert plot_bench(cases, tmp_path / "b.png").stat().st_size > 0
+
+
+def test_tables_1_and_6_1_leave_the_agents_to_their_own_table():
+    from baselines.bench import markdown_report
+
+    cases = [_case("optimal", "a", True, 8), _case("rule", "a", True, 9),
+             _case("agent:x", "a", True, 12)]
+    md = markdown_report(cases)
+    header = next(line for line in md.splitlines() if line.startswith("| object | mu | data"))
+    assert header.rstrip(" |").endswith("rule | optimal")  # no agent column
+    assert "agent:x" not in md
+    assert "| ellipse | 0.7 | x | point | 100% |" in agents_markdown(cases)
