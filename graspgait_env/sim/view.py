@@ -52,7 +52,8 @@ if TYPE_CHECKING:
 
     from graspgait_env.sim.model import HandPhysics, SimModel
 
-__all__ = ["HandView", "FINGER_RGB", "RING_FACTOR", "project_points"]
+__all__ = ["HandView", "FINGER_RGB", "RING_FACTOR", "offscreen_rendering_available",
+           "project_points"]
 
 # fingers 1, 2, 3: matplotlib's tab:red, tab:green, tab:blue (the map-level frames' colours)
 FINGER_RGB: tuple[tuple[int, int, int], ...] = ((214, 39, 40), (44, 160, 44), (31, 119, 180))
@@ -88,6 +89,17 @@ def _gl_context(width: int, height: int):
         raise RuntimeError(
             f"no OpenGL context for rendering ({cls.__module__}: {e}); headless, set "
             "MUJOCO_GL=egl (or osmesa) before MuJoCo is first imported") from e
+
+
+def offscreen_rendering_available() -> bool:
+    """Whether an off-screen OpenGL context opens here, as :class:`HandView` and
+    ``mujoco.Renderer`` need (headless: ``MUJOCO_GL=egl`` or ``osmesa``)."""
+    try:
+        context = _gl_context(16, 16)
+    except RuntimeError:
+        return False
+    context.free()
+    return True
 
 
 def project_points(camera: mujoco.MjvGLCamera | Sequence[mujoco.MjvGLCamera],

@@ -12,22 +12,15 @@ import numpy as np
 import pytest
 
 from graspgait_env.envs.render import FRAME_SIZE, GaitFrames, render_frame
+from graspgait_env.sim.view import offscreen_rendering_available
 
 PREFIX = "graspgait_env.envs:"
 
 
-def _can_render() -> bool:
-    try:
-        from graspgait_env.sim.executor import GaitExecutor
-        from graspgait_env.sim.view import HandView
-
-        HandView(GaitExecutor("circle").sim, width=64, height=48).close()
-        return True
-    except Exception:  # no OpenGL here
-        return False
 
 
-needs_gl = pytest.mark.skipif(not _can_render(), reason="no headless OpenGL (MUJOCO_GL=egl)")
+needs_gl = pytest.mark.skipif(not offscreen_rendering_available(),
+                              reason="no headless OpenGL (MUJOCO_GL=egl)")
 
 
 def _moves(env: gym.Env, n: int, seed: int = 0):

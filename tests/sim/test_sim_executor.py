@@ -15,6 +15,7 @@ from graspgait_env.plan import Plan
 from graspgait_env.sim import GaitExecutor, simulate_plan
 from graspgait_env.sim.config import load_sim_config
 from graspgait_env.sim.simulate import benchmark_step_rate, format_result, tug_test
+from graspgait_env.sim.view import offscreen_rendering_available
 
 RESULT_KEYS = {"success", "rotation_deg", "final_angle_error_deg", "dropped", "sim_time_s",
                "wall_time_s", "final_position_error_m", "slips", "steps"}
@@ -179,20 +180,10 @@ def test_tug_along_the_grip_with_the_check_off_loses_a_finger():
 
 
 # ----------------------------------------------------------------- video and step rates
-def _can_render() -> bool:
-    try:
-        import mujoco
-
-        from graspgait_env.sim.executor import GaitExecutor as _G
-
-        r = mujoco.Renderer(_G("circle", mu=0.7).sim.model, 48, 64)
-        r.close()
-        return True
-    except Exception:  # no OpenGL here: the video test cannot run
-        return False
 
 
-@pytest.mark.skipif(not _can_render(), reason="no headless OpenGL (MUJOCO_GL=egl) here")
+@pytest.mark.skipif(not offscreen_rendering_available(),
+                    reason="no headless OpenGL (MUJOCO_GL=egl) here")
 def test_video_is_written_atomically(tmp_path):
     import imageio_ffmpeg
 

@@ -9,19 +9,10 @@ import pytest
 from graspgait_env.plan import Plan
 from graspgait_env.sim.config import load_sim_config
 from graspgait_env.sim.executor import GaitExecutor
+from graspgait_env.sim.view import offscreen_rendering_available
 
-
-def _can_render() -> bool:
-    try:
-        from graspgait_env.sim.view import HandView
-
-        HandView(GaitExecutor("circle").sim, width=64, height=48).close()
-        return True
-    except Exception:  # no OpenGL here
-        return False
-
-
-pytestmark = pytest.mark.skipif(not _can_render(), reason="no headless OpenGL (MUJOCO_GL=egl)")
+pytestmark = pytest.mark.skipif(not offscreen_rendering_available(),
+                                reason="no headless OpenGL (MUJOCO_GL=egl)")
 
 
 class _Frames:
