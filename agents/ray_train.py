@@ -242,3 +242,69 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
                 "mu": mus[0] if len(mus) == 1 else None, "seed": seed,
                 "wall_s": time.perf_counter() - t0, "episodes": records})
     return out
+
+
+# ----------------------------------------------------------------------------- bench
+def _model_files(path: Path) -> dict[str, bytes]:
+    """A model zip and its card, as bytes that travel to a Ray worker."""
+    files = {".zip": path.read_bytes()}
+    if path.with_suffix(".json").is_file():
+        files[".json"] = path.with_suffix(".json").read_bytes()
+    return files
+
+
+def _bench_agent_cell(files: dict[str, bytes], name: str, obj: str, mu: float, starts: int,
+                      turn_deg: float) -> list[Any]:
+    """The serial agent bench of one agent on one (object, mu) cell (in a Ray worker)."""
+    from agents.bench import Agent, run_agent_bench
+    from agents.card import load_agent
+
+    with tempfile.TemporaryDirectory(prefix="graspgait-bench-") as tmp:
+        for suffix, data in files.items():
+            Path(tmp, name).with_suffix(suffix).write_bytes(data)
+        path = Path(tmp, name).with_suffix(".zip")
+        model, card = load_agent(path)
+        return run_agent_bench([Agent(name, path, model, card)], [obj], [mu], starts,
+                               turn_deg, progress=False)
+
+
+def bench_agents_on_ray(agents: Sequence[Any], objects: Sequence[str],
+                        mus: Sequence[float], starts: int = 10, turn_deg: float = 360.0, *,
+                        address: str | None = None, progress: bool = True
+                        ) -> tuple[list[Any], list[Any]]:
+    """:func:`agents.bench.run_agent_bench` with one Ray task per agent, object and mu.
+
+    Each task runs the serial agent bench on its cell (the model and its card travel
+    as bytes, so a remote cluster needs no copy of the files), and the cells' rows are
+    concatenated in the serial order (objects, then mus, then agents), so the rows are
+    those of ``run_agent_bench`` with the same arguments, wall times aside (a test
+    compares them). A failed cell is reported and the others kept.
+
+    Parameters
+    ----------
+    agents
+        :class:`agents.bench.Agent` items (``find_agents``).
+    objects, mus, starts, turn_deg
+        As for ``run_agent_bench``.
+    address
+        The Ray cluster (None: a local Ray; a Ray already running is used as it is).
+
+    Returns
+    -------
+    cases, failures
+        The :class:`~baselines.bench.BenchCase` rows of the cells that ran, and the
+        failed cells (:class:`~baselines.scale_out.TaskFailure`, label
+        ``"agent NAME on OBJECT mu=MU"``).
+    """
+    from baselines.scale_out import ray_session, run_tasks
+
+    cells = [(o, float(mu), a) for o in objects for mu in mus for a in agents if a.runs_on(o)]
+    if not cells:
+        return [], []
+    with ray_session(address) as ray:
+        refs = {id(a): ray.put(_model_files(Path(a.path))) for a in agents}
+        calls = [(refs[id(a)], a.name, o, mu, starts, turn_deg) for o, mu, a in cells]
+        labels = [f"agent {a.name} on {o} mu={mu:g}" for o, mu, a in cells]
+        results, failures = run_tasks(_bench_agent_cell, calls, labels, address=address,
+                                      desc="bench agents (ray)", progress=progress)
+    return [c for r in results if r is not None for c in r], failures

@@ -22,6 +22,7 @@ its parser to the subparsers and sets ``func`` (the handler, ``args -> int``).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 from collections.abc import Callable, Sequence
@@ -467,8 +468,13 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         load_object(o)  # refuse bad names before the long run
     _check_outputs(args, {"png": _figure_suffixes()})
     agents = _bench_agents(args.agents)  # agents.bench; loaded before the long run
-    cases = _bench_cases(args, objects, mus, planners)
-    cases, agents_report = agents(cases, objects, mus, args.starts)
+    with contextlib.ExitStack() as stack:
+        if args.ray is not None:  # one Ray session for the planners' and the agents' tasks
+            from baselines.scale_out import ray_session
+
+            stack.enter_context(ray_session(args.ray))
+        cases = _bench_cases(args, objects, mus, planners)
+        cases, agents_report = agents(args, cases, objects, mus, args.starts)
     report = bench.markdown_report(cases) + agents_report
     print(report)
     if args.csv:
@@ -514,16 +520,28 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
 
 
 def _bench_agents(spec: str) -> Callable[..., tuple[list, str]]:
-    """The agents' part of ``graspgait bench`` (agents.bench): ``run(cases, objects, mus,
-    starts) -> (cases + the agents' runs, their Markdown section)``."""
+    """The agents' part of ``graspgait bench`` (agents.bench): ``run(args, cases, objects,
+    mus, starts) -> (cases + the agents' runs, their Markdown section)``; with ``--ray``
+    one Ray task per agent, object and mu (a failed one is reported, the others kept)."""
     from agents.bench import agents_markdown, find_agents, run_agent_bench
 
     agents, notes = find_agents(spec)
 
-    def run(cases: list, objects: list[str], mus: list[float], starts: int) -> tuple[list, str]:
+    def run(args: argparse.Namespace, cases: list, objects: list[str], mus: list[float],
+            starts: int) -> tuple[list, str]:
         if not agents and not notes:
             return cases, ""
-        cases = cases + run_agent_bench(agents, objects, mus, starts)
+        if args.ray is None:
+            runs = run_agent_bench(agents, objects, mus, starts)
+        else:
+            from agents.ray_train import bench_agents_on_ray
+
+            runs, failures = bench_agents_on_ray(agents, objects, mus, starts,
+                                                 address=args.ray)
+            for f in failures:
+                _error(f"bench cell {f.label} failed on Ray: {f.error}")
+            args.failed_cells = getattr(args, "failed_cells", 0) + len(failures)
+        cases = cases + runs
         return cases, "\n\n" + agents_markdown(cases, notes)
 
     return run

@@ -108,6 +108,47 @@ def test_train_seeds_as_ray_tune_trials_give_the_serial_numbers(local_ray, tmp_p
 
 
 @pytest.mark.slow
+def test_a_failed_tune_trial_is_reported_and_the_others_kept(local_ray, tmp_path):
+    """Seed 2**64 overflows torch's seed: that trial fails, seed 0's still trains."""
+    from agents.config import load_train_config
+    from agents.ray_train import train_seeds
+
+    config = load_train_config("smoke", [f"run_root={tmp_path}"])
+    trials = train_seeds(config, [0, 2**64], use_ray=True, progress=False)
+    assert [o.seed for o in trials] == [0, 2**64]
+    assert trials[0].error is None and trials[0].steps == 256
+    assert trials[1].error and "Overflow" in trials[1].error and trials[1].steps == 0
+
+
+def test_bench_agents_on_ray_gives_the_serial_rows(local_ray):
+    """One Ray task per agent, object and mu; the rows are the serial bench's."""
+    from agents.bench import find_agents, run_agent_bench
+    from agents.ray_train import bench_agents_on_ray
+
+    agents, _ = find_agents("circle,pentagon")
+    args = (agents, ["pentagon", "circle"], [0.7], 2)
+    serial = run_agent_bench(*args, progress=False)
+    cases, failures = bench_agents_on_ray(*args, progress=False)
+    assert failures == []
+    assert len(serial) == 4  # each agent on its own object, 2 starts
+    assert [_no_wall(dataclasses.asdict(c)) for c in cases] == [
+        _no_wall(dataclasses.asdict(c)) for c in serial]
+
+
+def test_cli_bench_ray_with_an_agent_writes_the_serial_json(local_ray, tmp_path, capsys):
+    import json
+
+    argv = ["bench", "--objects", "pentagon", "--mus", "0.7", "--planners", "rule",
+            "--starts", "1", "--agents", "pentagon"]
+    assert main([*argv, "--json", str(tmp_path / "serial.json")]) == 0
+    assert main([*argv, "--ray", "--json", str(tmp_path / "ray.json")]) == 0
+    capsys.readouterr()
+    serial, on_ray = (json.loads((tmp_path / f).read_text()) for f in ("serial.json", "ray.json"))
+    assert any("agent:pentagon" in json.dumps(c) for c in serial["runs"])
+    assert _no_wall(on_ray) == _no_wall(serial)
+
+
+@pytest.mark.slow
 def test_evaluate_on_ray_gives_the_serial_result(local_ray, tmp_path):
     from agents.config import load_train_config
     from agents.evaluate import evaluate
