@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import heapq
 import time
+import weakref
 from collections.abc import Iterator
 from typing import Any
 
@@ -32,7 +33,7 @@ from graspgait_env.planners.search import TIE_BREAKS
 from graspgait_env.planners.starts import check_start, no_start_verdict, spread_starts
 from graspgait_env.planners.trace import Trace, gait_failure, gait_pattern, gait_result
 
-__all__ = ["modified_search", "map_structure", "DEFAULT_MAX_NODES"]
+__all__ = ["modified_search", "map_structure", "w_wide_grasps", "DEFAULT_MAX_NODES"]
 
 DEFAULT_MAX_NODES = 20_000  # (nodes opened) cap of the modified search
 
@@ -50,12 +51,19 @@ class _Modified:
     """Best-first search over the moves of one gait structure (thesis 6.4)."""
 
     def __init__(self, model: GaitModel, g: WorkspaceGrid, K: int, plus: bool,
-                 tie_break: str = "newest", one_step_size: bool = False) -> None:
+                 tie_break: str = "newest", one_step_size: bool = False,
+                 w_wide: NDArray[np.bool_] | None = None) -> None:
         self.m, self.g, self.K, self.plus = model, g, K, plus
         self.one_step_size = one_step_size  # one step size per kind of move (see search)
         self.tick = 1 if tie_break == "oldest" else -1  # heap order of equal-M nodes
         self.sign = 1 if K >= 0 else -1
         self.tiled = np.tile(np.asarray(model.stable, dtype=bool), (1, 2))
+        # the grasps a regrasp may move to: every stable one, or the w-wide ones
+        # (:func:`w_wide_grasps`) in the first pass of the plus structure; the look-ahead
+        # of :meth:`_any_regrasp` reads the whole map (measured: reading the w-wide
+        # grasps there too, ellipse 1.29 nodes per move but hexagon gaits 13.6 regrasps)
+        self.movable = self.tiled if w_wide is None else np.tile(
+            np.asarray(w_wide, dtype=bool), (1, 2))
         # prefix sums of every map row (the look-ahead) and the fingers' neighbours
         self.csum = np.concatenate((np.zeros((model.n, 1), dtype=np.int64),
                                     np.cumsum(self.tiled, axis=1)), axis=1)
@@ -76,7 +84,7 @@ class _Modified:
         keep = g2 if lift == f else f
         W = int(m.ws_width[h])
         i0 = (int(m.ws_start[h]) - s.k) % m.n
-        ok = self.tiled[s.contacts[keep], i0 : i0 + W]
+        ok = self.movable[s.contacts[keep], i0 : i0 + W]
         ps = np.flatnonzero(ok)
         if sign < 0:
             ps = ps[::-1]
@@ -218,7 +226,7 @@ class _Modified:
             _, _, s, phase, eta, r = heapq.heappop(heap)
             self.opened += 1
             kids: list[tuple[float, GaitState, str, int, int]] = []
-            kinds: set[tuple[str, str]] = set()
+            kinds: set[tuple[str, str, bool]] = set()
             for moves, dreg, drot in self.steps(s, phase, is_start=(s, phase) == key0):
                 self.created += 1
                 t, ph, _ = moves[-1]
@@ -226,8 +234,12 @@ class _Modified:
                 if key in parent:  # thesis 5.5: only the first path to a node
                     continue
                 if self.one_step_size:
-                    # the rules' step size only: the first new child of each kind of move
-                    kind = (moves[0][2], ph)
+                    # the rules' step size only: the first new child of each kind of move;
+                    # a first backward regrasp after which a second one exists (rules
+                    # 6-7-8, 9-10-11) is another kind than one after which none does
+                    # (rules 6-8, 9-11)
+                    kind: tuple[str, str, bool] = (moves[0][2], ph, ph == _BACK1 and any(
+                        True for _ in self.regrasps(t, forward=False)))
                     if kind in kinds:
                         continue
                     kinds.add(kind)
@@ -258,6 +270,66 @@ class _Modified:
             key = prev
         states.append(start)
         return states[::-1], labels[::-1]
+
+
+def _run_lengths(stable: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """For each cell, the length of the run of stable cells through it along its row
+    (axis 1), the map wrapping round (at most ``n``); 0 for an unstable cell."""
+    S = np.asarray(stable, dtype=bool)
+    n = S.shape[1]
+    T = np.tile(S, (1, 3))  # the middle copy sees every wrapped run whole
+    ahead = _run_so_far(T)
+    behind = _run_so_far(T[:, ::-1])[:, ::-1]
+    run = (ahead + behind - 1)[:, n : 2 * n]
+    return np.where(S, np.minimum(run, n), 0)
+
+
+def _run_so_far(T: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Stable cells in a row up to and including each cell since the last unstable one."""
+    c = np.cumsum(T, axis=1)
+    return c - np.maximum.accumulate(np.where(T, 0, c), axis=1)
+
+
+def w_wide_grasps(stable: NDArray[np.bool_], w_steps: int) -> NDArray[np.bool_]:
+    """The stable grasps whose stable region is at least ``w`` wide and tall there.
+
+    Thesis 6.3.2 (fig. 6.11 (a)): "a forward move ... or a backward move ... can only be
+    made if the dimensions of the box are at least w × w". With no box (6.4) this is
+    read on the map itself: cell ``(a, b)`` qualifies when the run of stable cells
+    through it is at least ``w_steps`` long along both axes (``a`` varying with ``b``
+    held, and ``b`` varying with ``a`` held; the map wraps round).
+
+    Parameters
+    ----------
+    stable
+        The ``(n, n)`` grasp map.
+    w_steps
+        The gap ``w`` between workspaces, in grid steps.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n, n)`` boolean, a subset of ``stable``.
+    """
+    S = np.asarray(stable, dtype=bool)
+    along_b = _run_lengths(S)
+    along_a = _run_lengths(S.T).T
+    return S & (along_a >= w_steps) & (along_b >= w_steps)
+
+
+# w_wide_grasps per model, keyed on its map array and w
+_W_WIDE: weakref.WeakKeyDictionary[GaitModel, dict[tuple[int, int], NDArray[np.bool_]]] = (
+    weakref.WeakKeyDictionary())
+
+
+def _model_w_wide(model: GaitModel, w_steps: int) -> NDArray[np.bool_]:
+    """:func:`w_wide_grasps` of ``model``'s map, computed once per model, map and ``w``."""
+    per = _W_WIDE.setdefault(model, {})
+    key = (id(model.stable), w_steps)
+    if key not in per:
+        per.clear()
+        per[key] = w_wide_grasps(model.stable, w_steps)
+    return per[key]
 
 
 def map_structure(model: GaitModel) -> str:
@@ -322,7 +394,14 @@ def modified_search(model: GaitModel, start: GaitState | None = None, turn_deg: 
     largest backward). So each structure is searched first with one step size per kind
     of move — the first new one in the rules' order — and, only when that tree is
     exhausted, again with every step size (the nodes of both passes add up; order:
-    rules' sizes for each structure, then every size for each).
+    rules' sizes for each structure, then every size for each). In the first pass a
+    first backward regrasp after which a second one exists (rules 6-7-8, 9-10-11) and
+    one after which none does (rules 6-8, 9-11) are different kinds, and a regrasp
+    moves only to a grasp whose stable region is at least ``w`` wide and tall there
+    (:func:`w_wide_grasps`; 6.3.2, fig. 6.11 (a): a move "can only be made if the
+    dimensions of the box are at least w × w"), a condition of the box prototype, so
+    of the plus structure only (the staircase's band has its own, 6.3.1); the second
+    pass drops both.
 
     Measured (``graspgait bench --mus 0.7 --planners modified``: nodes opened per path
     move, mean regrasps, over the bench's ten starts; all succeed):
@@ -333,16 +412,33 @@ def modified_search(model: GaitModel, start: GaitState | None = None, turn_deg: 
     siblings newest-created first       1.00/148.6 54.2/29.5  0.53/14.8  72.4/16.0
     rules' first choice first           0.51/7.8   9.27/13.6  1.71/12.1  17.7/12.4
     + dead-end look-ahead               0.51/7.8   6.77/13.6  0.62/12.1  9.78/13.0
-    + rules' step sizes first (this)    0.51/7.8   2.91/13.9  0.62/12.1  1.39/13.4
+    + rules' step sizes first           0.51/7.8   2.91/13.9  0.62/12.1  1.39/13.4
+    + two kinds of 1st backward, alone  0.51/7.8   3.06/13.9  0.62/12.1  1.39/13.4
+    + moves to w-wide grasps alone      0.51/7.8   2.19/13.0  0.62/12.1  1.16/13.4
+    + both (this)                       0.51/7.8   1.47/12.9  0.62/12.1  1.16/13.4
     ==================================  =========  =========  =========  =========
+
+    At mu 0.8 the last row reads 0.53/7.8, 0.65/9.0, 0.56/9.0, 0.84/11.0 (the row
+    before both: 0.53/7.8, 0.90/9.2, 0.56/9.0, 1.27/12.3).
+
+    Where the nodes went on the ellipse at mu 0.7 (nodes opened per start, the
+    bench's ten starts in order, before -> after the last row: 48->19, 25->25, 35->25,
+    70->41, 87->25, 69->32, 77->52, 151->35, 52->35, 49->29). Two causes. *Traps*: from
+    grasps in the thin strips that run off the corners of the map's large stable box
+    (less than ``w`` wide, e.g. (20°, 206°), (132°, 206°)) the + structure chains small
+    + cycles (backward regrasps, a forward one, a rotation of 2-8 degrees) whose ``M``
+    still rises, and every node of such a trap above the path's next dip is opened
+    before the search backs out: from the start (70°, 298°) about 55 nodes at theta
+    208-258 degrees, the path's dip being at theta 176 degrees; the w-wide condition
+    keeps the first pass out of the strips. *The every-step-size pass*: from (128°,
+    314°) the first pass's one backward step per node fails (29 nodes) and the second
+    pass opens each of ~30 equal-``M`` backward regrasps of a node before the children
+    of any (121 nodes); with the two kinds of first backward regrasp the first pass
+    finds the gait (35 nodes).
 
     The first row opened the rules' *last* choice first among equal-``M`` siblings
     (the largest forward step, after which the least rotation remains), which on the
-    circle chains a regrasp and a 2-degree rotation at no change of ``M``. On the ellipse
-    the + structure still opens 2.9 nodes per move (thesis 6.5: "close to equal to the
-    path length", measured on its pentagon only): after a rotation to the forward limit
-    the search follows small + cycles (a backward, a forward regrasp and a few degrees)
-    whose ``M`` stays above the path's dip at its next backward regrasp. Tried and not
+    circle chains a regrasp and a 2-degree rotation at no change of ``M``. Tried and not
     kept (measured on the same starts): deferring the charge of regrasps that no
     rotation follows (ellipse 19.5), a closed set keyed on the grasp without its phase
     (6.77, no change), a deeper dead-end look-ahead (no change), rotating only to the
@@ -350,7 +446,16 @@ def modified_search(model: GaitModel, start: GaitState | None = None, turn_deg: 
     ellipse 4.95), only forward regrasps after a forward-limit rotation and only
     backward ones after an upper/right-limit rotation (6.3.2 rules 5, 6, 9: 2 of 10
     starts fail on the ellipse and on the hexagon), and one step size only, without the
-    second pass (ellipse 2.50, but one start of ten fails).
+    second pass (ellipse 2.50, but one start of ten fails). On top of this version:
+    a first pass with the rotation of 6.3.2 rules 1-4 read on the map (to the
+    upper/right limit when the grasp is less than ``w`` from a forward edge of its
+    stable runs, else to the rotation limit; ellipse 1.02 and hexagon 0.75 nodes per
+    move at mu 0.7, but at mu 0.8 the ellipse's gaits grow from 9.0 to 10.9 regrasps
+    and the pentagon's from 9.0 to 9.7), and the w-wide condition read as "covered by
+    a stable w × w square" (ellipse 1.47, and applied to the staircase as well it
+    drops the pentagon's gaits to 9.1 regrasps at mu 0.7, which the rule-based method
+    reports against Table 6.1's 14.5; the runs read on the staircase as well: pentagon
+    0.65/12.0).
 
     Parameters
     ----------
@@ -409,6 +514,7 @@ def modified_search(model: GaitModel, start: GaitState | None = None, turn_deg: 
     order = [first] if structure else [first, "plus" if first == "staircase" else "staircase"]
     opened = created = best = 0
     exhausted = True
+    w_wide: NDArray[np.bool_] | None = None  # computed on the first plus pass
     for s0 in starts:
         # the rules' step sizes first (each structure), then every step size
         passes = [(i, st, one) for one in (True, False) for i, st in enumerate(order)]
@@ -416,8 +522,11 @@ def modified_search(model: GaitModel, start: GaitState | None = None, turn_deg: 
             budget = max_nodes - opened
             if len(order) == 2 and i == 0:
                 budget = min(budget, max_nodes // 2)
+            if one and st == "plus" and w_wide is None:
+                w_wide = _model_w_wide(model, g.w_steps)
             srch = _Modified(model, g, K, plus=(st == "plus"), tie_break=tie_break,
-                             one_step_size=one)
+                             one_step_size=one,
+                             w_wide=w_wide if one and st == "plus" else None)
             found = srch.search(s0, budget)
             opened += srch.opened
             created += srch.created
