@@ -241,6 +241,11 @@ class GraspGaitConfig:
     simulated hand's rolling ball tips with the friction margin its rotations need, so
     that what is learned on the map runs on the hand (``GraspGaitMujoco-v1``'s
     default)."""
+    rotation_lookahead: bool = False
+    """Append, for each rotation action, whether a regrasp is legal after that rotation
+    (``2 R`` entries, 1: the rotation opens at least one regrasp; a one-step look-ahead
+    of the legal-move function of thesis 4.2 and 5.2, not the optimum's regrasps to go;
+    see the env's *Observation Space*). False (the default): no look-ahead."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -277,6 +282,10 @@ class GraspGaitConfig:
         if not isinstance(self.map_lines, (bool, np.bool_)):
             raise GraspGaitInputError(f"map_lines={self.map_lines!r}: must be True or False")
         put("map_lines", bool(self.map_lines))
+        if not isinstance(self.rotation_lookahead, (bool, np.bool_)):
+            raise GraspGaitInputError(
+                f"rotation_lookahead={self.rotation_lookahead!r}: must be True or False")
+        put("rotation_lookahead", bool(self.rotation_lookahead))
         from graspgait_env.contact_model import CONTACT_MODELS
 
         if self.contact_model not in CONTACT_MODELS:

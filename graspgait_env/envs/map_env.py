@@ -13,7 +13,7 @@ from __future__ import annotations
 import inspect
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -40,6 +40,7 @@ __all__ = [
     "ObservationLayout",
     "REWARD_TERMS",
     "ResetNeededError",
+    "regrasp_openings",
     "state_from_observation",
 ]
 
@@ -62,14 +63,18 @@ class ObservationLayout:
 
     Attributes
     ----------
-    held, position, contact_cos_sin, theta_cos_sin, achieved, to_go, mask, window, lines
+    held, position, contact_cos_sin, theta_cos_sin, achieved, to_go, mask, window, lines,
+    lookahead
         Slices (``achieved`` and ``to_go`` are indices); ``window`` reshapes to
-        ``(cells, cells)``, ``lines`` (``map_lines``; else empty) to ``(2, n)``.
+        ``(cells, cells)``, ``lines`` (``map_lines``; else empty) to ``(2, n)``;
+        ``lookahead`` (``rotation_lookahead``; else empty) has one entry per rotation
+        action, ``2 R``.
     size
         Length of the observation vector.
     """
 
-    def __init__(self, n_actions: int, cells: int, line_cells: int = 0) -> None:
+    def __init__(self, n_actions: int, cells: int, line_cells: int = 0,
+                 lookahead: int = 0) -> None:
         self.held = slice(_HELD, _HELD + 3)
         self.position = slice(_POS, _POS + 3)
         self.contact_cos_sin = slice(_PHI, _PHI + 6)
@@ -80,8 +85,10 @@ class ObservationLayout:
         self.window = slice(_HEADER + n_actions, _HEADER + n_actions + cells * cells)
         end = self.window.stop
         self.lines = slice(end, end + 2 * line_cells)  # empty unless map_lines
+        end = self.lines.stop
+        self.lookahead = slice(end, end + lookahead)  # empty unless rotation_lookahead
         self.cells = cells
-        self.size = end + 2 * line_cells
+        self.size = end + lookahead
 
 
 class ResetNeededError(gym.error.ResetNeeded, RuntimeError):
@@ -91,6 +98,28 @@ class ResetNeededError(gym.error.ResetNeeded, RuntimeError):
     Both Gymnasium's ``ResetNeeded`` (what ``gymnasium.make``'s order enforcing raises)
     and a ``RuntimeError``.
     """
+
+
+def draw_start_index(rng: np.random.Generator, n_starts: int,
+                     has_move: Callable[[int], bool]) -> int | None:
+    """Index of a start grasp drawn as every GraspGait env draws it (*Starting State*).
+
+    A uniform index, redrawn up to ``_START_TRIES`` times while ``has_move(i)`` is False
+    (the grasp has no legal move); then a scan of all starts from a uniform offset.
+    ``None`` when no start has a legal move. The one definition of the draw: the
+    batched env calls it with its own table of ``has_move`` so that a sub-env's starts
+    (and every later draw of its generator) are the single env's.
+    """
+    for _ in range(_START_TRIES):
+        i = int(rng.integers(n_starts))
+        if has_move(i):
+            return i
+    off = int(rng.integers(n_starts))
+    for t in range(n_starts):
+        i = (off + t) % n_starts
+        if has_move(i):
+            return i
+    return None
 
 
 def _pooled_map(stable: NDArray[np.bool_], s: int) -> NDArray[np.float32]:
@@ -105,6 +134,26 @@ def _pooled_map(stable: NDArray[np.bool_], s: int) -> NDArray[np.float32]:
     cs[1:, 1:] = x.cumsum(axis=0).cumsum(axis=1)
     box = cs[s:s + n, s:s + n] - cs[:n, s:s + n] - cs[s:s + n, :n] + cs[:n, :n]
     out = np.tile((box / (s * s)).astype(np.float32), (2, 2))
+    out.flags.writeable = False
+    return out
+
+
+def regrasp_openings(model: GaitModel) -> NDArray[np.bool_]:
+    """``out[h, c, i]``: some regrasp is legal that keeps held contact ``c`` and places the
+    free finger ``h`` in its workspace when the workspace's first grid angle touches
+    object contact ``i`` (thesis 4.2: the new pair must be force-closure).
+
+    The regrasp rule of :meth:`GaitModel.action_mask` (contacts ``i .. i + W_h - 1``
+    against ``c``, a run of the extended grasp map) reduced to "any" by a running count,
+    for every ``c`` and ``i < n``: with the free finger ``h`` at object angle ``k``,
+    ``i = (s_h - k) mod n``. Shape ``(3, n, n)``, read-only.
+    """
+    n = model.n
+    rows = model.grasp_map.extended().T[:n]  # rows[c, j]: contact c against contact j mod n
+    count = np.zeros((n, rows.shape[1] + 1), dtype=np.int32)
+    np.cumsum(rows, axis=1, out=count[:, 1:])
+    i = np.arange(n)
+    out = np.stack([count[:, i + int(w)] > count[:, i] for w in model.ws_width])
     out.flags.writeable = False
     return out
 
@@ -177,7 +226,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     ## Observation Space
 
     A flat ``Box(float32)`` of length ``16 + n_actions + cells**2`` (1494 by default;
-    ``2 n`` more with ``map_lines``),
+    ``2 n`` more with ``map_lines``, then ``2 R`` more with ``rotation_lookahead``),
     every entry inside its bounds. Fingers ``f = 1, 2, 3``; ``T`` = ``turn_deg``;
     ``sigma = sign(T)``; ``B`` = ``max_backward_deg``; ``Δ = 360 / n``; ``θ`` the object
     angle (degrees, CCW).
@@ -200,6 +249,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     | 15+A+C²       | (see below)                                  |              |              |
     | 16+A+C² ..    | with ``map_lines``: the grasp map's lines    | 0            | 1            |
     | 15+A+C²+2n    | through the grasp (see below), ``2 x n``     |              |              |
+    | next ``2R``   | with ``rotation_lookahead``: per rotation    | 0            | 1            |
+    |               | action ``a < 2R``, 1 when ``a`` is legal and |              |              |
+    |               | a regrasp is legal after it (see below)      |              |              |
 
     With the defaults (``T = B = 360°``, ``R Δ = 90°``) the turn achieved lies in
     ``[-1.25, 1.25]`` and the turn to go in ``[0, 2.25]``.
@@ -224,6 +276,19 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     ``p`` and keeping ``f`` (``l = 1``) is legal exactly when line 0 is 1 at ``j = s_h +
     p`` (keeping ``g``: line 1); a rotation by ``d`` steps shifts both lines by ``d``,
     so they show which regrasps a rotation would open, over the whole circle.
+
+    The **rotation look-ahead** (``rotation_lookahead=True``; off by default; beyond the
+    thesis) answers, for each rotation action, whether the move after it may be a
+    regrasp: entry ``a`` (``a < 2R``, the rotation by ``d_a`` grid steps of the *Action
+    Space*) is 1 when rotation ``a`` is legal now and the state it leads to, ``(k + d_a,
+    same contacts)``, has at least one legal regrasp (either lift), i.e. one step of
+    :meth:`GaitModel.action_mask <graspgait_env.gait.GaitModel.action_mask>` looked ahead
+    (thesis 5.2 for the rotation, 4.2 for the regrasp). It uses the legal-move function
+    only, never the optimum's regrasps to go. Regrasps open only at a few object angles
+    of a grasp's rotation range on maps with few force-closure grasps (the hexagon with
+    the hand's ball tips: about one legal regrasp per grasp among about 30 legal
+    rotations), where a policy that must find those angles by trial rarely regrasps.
+    ``GraspGaitMujoco-v1`` computes it from the commanded state, as its header.
 
     With the held fingers, positions and turn achieved the observation determines the
     state exactly: :func:`state_from_observation`.
@@ -295,7 +360,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     units): ``hand=None, turn_deg=360.0, n=180, alpha=1.0, beta=0.01, gamma=0.01,
     turn_scale_deg=None, success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1,
     to_go_weight=0.0, max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36,
-    map_lines=False``.
+    map_lines=False, contact_model="point", rotation_lookahead=False``.
 
     - ``object``: bundled name (``"ellipse"``, the thesis's fig. 5.3 ellipse), YAML path
       or :class:`~graspgait_env.shapes.Shape`.
@@ -311,6 +376,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     - ``max_backward_deg``: wrong-way limit (above).
     - ``map_window_deg, map_window_cells``: span and resolution of the grasp-map window.
     - ``map_lines``: append the grasp map's two lines through the grasp (above).
+    - ``contact_model``: ``"point"`` (the thesis's) or ``"hand"`` (the simulated hand's
+      ball tips; see :class:`~graspgait_env.envs.config.GraspGaitConfig`).
+    - ``rotation_lookahead``: append the rotation look-ahead (above).
     - ``render_mode``: ``"rgb_array"`` returns a ``(480, 640, 3)`` uint8 frame: the
       object in the workspace frame with the three workspaces and the fingers, and the
       extended grasp map (finger pair boxes at the present θ) with the gait so far
@@ -426,6 +494,10 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         # the map's rows tiled twice: a held contact's line at angle k is one slice
         self._line_src = (np.tile(model.stable, (1, 2)).astype(np.float32)
                           if cfg.map_lines else None)
+        # rotation_lookahead: which rotations open a regrasp (thesis 4.2, 5.2), per model
+        self._openings = regrasp_openings(model) if cfg.rotation_lookahead else None
+        self._rot_delta = np.asarray(self._delta[:2 * model.R], dtype=np.int64)
+        self._ws_start = [int(x) for x in model.ws_start]
         self._starts: list[GaitState] | None = None
         # regrasps to go from every state (the exact optimum's count; only when rewarded)
         self._to_go = (RegraspsToGo(model, cfg.turn_deg, cfg.max_backward_deg)
@@ -434,7 +506,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def _make_spaces(self) -> None:
         A, C = self._A, self.config.map_window_cells
-        self.layout = ObservationLayout(A, C, self._n if self.config.map_lines else 0)
+        self.layout = ObservationLayout(A, C, self._n if self.config.map_lines else 0,
+                                        2 * int(self.model.R)
+                                        if self.config.rotation_lookahead else 0)
         lo = np.zeros(self.layout.size, dtype=np.float64)
         hi = np.ones(self.layout.size, dtype=np.float64)
         lo[_POS:_THETA + 2] = -1.0
@@ -448,6 +522,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
         self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
+        self._look_view = self._obs[self.layout.lookahead]
 
     def _check_model_fits(self, model: GaitModel) -> None:
         if int(model.n_actions) != self.action_space.n or model.n != self._n:
@@ -532,6 +607,12 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         o[_ACHIEVED] = t / self._Kabs
         o[_TO_GO] = max(0, self._Kabs - t) / self._Kabs
         self._mask_view[...] = self._mask
+        if self._openings is not None:  # thesis 4.2, 5.2: the regrasps a rotation opens
+            # after rotating by d the free finger's workspace starts at contact s_h - k - d
+            i = (self._ws_start[self._h] - k - self._rot_delta) % self._n
+            opens = self._openings[self._h]
+            self._look_view[...] = ((opens[self._c[f], i] | opens[self._c[g], i])
+                                    & self._mask[:self._rot_delta.size])
 
     # ------------------------------------------------------------------ reward
     def _reward(self, k0: int, k1: int, move: str | None, ends: bool,
@@ -595,18 +676,13 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             raise GraspGaitInputError(
                 f"object {self.model.shape.name!r} at mu={self.model.mu:g}: no legal grasp at "
                 "theta = 0 with this hand; raise mu or change the hand")
-        rng = self.np_random
-        for _ in range(_START_TRIES):
-            s = starts[int(rng.integers(len(starts)))]
-            self._set_state(s)
-            if self._compute_mask().any():
-                return s
-        off = int(rng.integers(len(starts)))
-        for i in range(len(starts)):
-            s = starts[(off + i) % len(starts)]
-            self._set_state(s)
-            if self._compute_mask().any():
-                return s
+        def has_move(i: int) -> bool:
+            self._set_state(starts[i])
+            return bool(self._compute_mask().any())
+
+        i = draw_start_index(self.np_random, len(starts), has_move)
+        if i is not None:
+            return starts[i]
         raise GraspGaitInputError(
             f"object {self.model.shape.name!r} at mu={self.model.mu:g}: every legal start "
             f"grasp ({len(starts)}) is a dead end; raise mu or change the hand")
@@ -798,6 +874,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         d.pop("_win_view", None)  # views into _obs, rebuilt on unpickling
         d.pop("_mask_view", None)
         d.pop("_line_view", None)
+        d.pop("_look_view", None)
         return d
 
     def __setstate__(self, d: dict[str, Any]) -> None:
@@ -806,6 +883,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
         self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
+        self._look_view = self._obs[self.layout.lookahead]
 
 
 def _config_property(name: str) -> property:

@@ -33,6 +33,7 @@ from graspgait_env.envs.map_env import (
     REWARD_TERMS,
     GraspGaitEnv,
     ResetNeededError,
+    draw_start_index,
 )
 from graspgait_env.envs.registration import MAX_EPISODE_STEPS
 from graspgait_env.errors import GraspGaitInputError
@@ -48,7 +49,7 @@ RUNS_TABLE_MAX = 1 << 24  # (bools) the contiguous regrasp-run table; n = 180 ne
 SUPPORTED_FIELDS: frozenset[str] = frozenset({
     "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
     "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
-    "map_window_deg", "map_window_cells", "map_lines", "contact_model",
+    "map_window_deg", "map_window_cells", "map_lines", "contact_model", "rotation_lookahead",
 })
 
 
@@ -138,9 +139,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     - ``copy``: return fresh observation arrays (default) or the env's buffer.
 
     Every field of today's config is implemented: ``map_lines`` adds the map lines to
-    each row, ``contact_model`` changes the shared gait model, ``to_go_weight`` looks up
-    the optimum's regrasps to go of each sub-env that regrasps, one at a time (this
-    opt-in reward slows the batched step). A field added to the config later
+    each row, ``rotation_lookahead`` the rotation look-ahead, ``contact_model`` changes
+    the shared gait model, ``to_go_weight`` looks up the optimum's regrasps to go of
+    each sub-env that regrasps, one at a time (this opt-in reward slows the batched
+    step). A field added to the config later
     (:data:`SUPPORTED_FIELDS` does not list it) is accepted at its default and raises
     ``ValueError`` naming it otherwise. ``render_mode`` must be None: the batched env
     draws nothing (make a single env with ``render_mode="rgb_array"`` to watch one
@@ -198,6 +200,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # random generator), so starts are drawn by the single env's own code
         starts = env.model.start_states()
         env._starts = starts
+        # for autoresets in step (_autoreset_subs): each start's contacts and whether it
+        # has a legal move (the single env's _draw_start redraws those without one)
+        self._start_contacts = np.array([s.contacts for s in starts],
+                                        dtype=np.int64).reshape(-1, 3)
+        self._start_ok = [bool(env.model.action_mask(s).any()) for s in starts]
         self._subs: list[GraspGaitEnv] = []
         for _ in range(N):
             sub = _copy_env(env)
@@ -259,6 +266,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # up one regrasp at a time, so this opt-in reward costs speed)
         self._to_go = env._to_go
         self._togo_now = np.full(N, -1, dtype=np.int64)
+        # rotation_lookahead: the single env's table of the regrasps each rotation opens
+        self._openings = env._openings
+        self._rot_delta = env._rot_delta
 
         # batched state: object angle k, contacts c (-1: free), workspace positions p
         # (-1: free), held fingers f < g and free finger h, mask, counters
@@ -363,7 +373,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             self._k[i] = s.k
             self._c[i] = s.contacts
             infos = self._add_info(infos, info, i)
-        idx = np.asarray(idx, dtype=np.int64)
+        self._load_starts(np.asarray(idx, dtype=np.int64))
+
+    def _load_starts(self, idx: NDArray[np.int64]) -> None:
+        """Batched state of sub-envs ``idx`` whose contacts ``_c`` were just set to a
+        start grasp: fingers, workspace positions and counters (``k`` is 0)."""
         c = self._c[idx]
         h = np.argmin(c, axis=1)  # the free finger: the one contact that is -1
         self._h[idx] = h
@@ -374,10 +388,40 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._p[idx] = np.where(c >= 0, p, -1)
         self._regrasps[idx] = 0
         if self._to_go is not None:
+            from graspgait_env.gait import GaitState
+
             for i in idx.tolist():
-                self._togo_now[i] = self._to_go(self._subs[i].state)
+                self._togo_now[i] = self._to_go(GaitState(int(self._k[i]),
+                                                          tuple(self._c[i].tolist())))
         self._elapsed[idx] = 0
         self._autoreset[idx] = False
+
+    def _autoreset_subs(self, idx: NDArray[np.int64], infos: dict[str, Any]) -> None:
+        """Restart sub-envs ``idx`` (their episode ended at the last step) in batch.
+
+        Each draws its start grasp from its own generator with the single env's draw
+        (:func:`~graspgait_env.envs.map_env.draw_start_index`, from a table of which
+        starts have a legal move), so the start, and every later draw, is the single
+        env's; the rest of the single env's
+        ``reset`` (its observation, mask and info) is done for the whole batch by
+        :meth:`step`. The reset infos that the step does not overwrite, ``object`` and
+        ``mu``, are batched as ``SyncVectorEnv`` batches them (``_add_info``).
+        """
+        has_move = self._start_ok.__getitem__
+        L = len(self._start_ok)
+        # never None: the first reset found a start with a legal move
+        picks = [draw_start_index(self._subs[i].np_random, L, has_move) for i in idx.tolist()]
+        self._k[idx] = 0
+        self._c[idx] = self._start_contacts[picks]
+        self._load_starts(idx)
+        on = np.zeros(self.num_envs, dtype=bool)
+        on[idx] = True
+        name = np.full(self.num_envs, None, dtype=object)
+        name[idx] = self.model.shape.name
+        mu = np.zeros(self.num_envs, dtype=float)
+        mu[idx] = self.model.mu
+        infos["object"], infos["_object"] = name, on
+        infos["mu"], infos["_mu"] = mu, on.copy()
 
     def reset(self, *, seed: int | Sequence[int | None] | None = None,
               options: dict[str, Any] | None = None) -> tuple[NDArray[np.float32], dict]:
@@ -450,7 +494,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
                 f"array of shape ({N},)")
         if a.dtype != np.int64:
             a = a.astype(np.int64)
-        if N and (a.min() < 0 or a.max() >= A):
+        if N and (a.view(np.uint64) >= A).any():  # negatives wrap to huge values
             i = int(np.flatnonzero((a < 0) | (a >= A))[0])
             raise GraspGaitInputError(
                 f"actions[{i}]={int(a[i])}: outside the action space 0..{A - 1}")
@@ -513,18 +557,18 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         a = self._check_actions(actions)
         N, R, n = self.num_envs, self._R, self._n
         infos: dict[str, Any] = {}
-        reset_idx = np.flatnonzero(self._autoreset)
+        reset_idx = self._autoreset.nonzero()[0]
         live = ~self._autoreset
         legal = self._mask.ravel().take(self._rowA + a) & live
         d = self._delta[a]
         rot = legal & (d != 0)
-        rg = legal & (d == 0)
+        rg = legal ^ rot  # legal and not a rotation
         # rotations (thesis 5.2): both contacts move d grid steps through their workspaces
         dk = np.where(rot, d, 0)
         self._k += dk
         self._p += dk[:, None] * (self._c >= 0)
         # regrasps (thesis 4.2): the free finger h to position p, the lifted finger freed
-        ri = np.flatnonzero(rg)
+        ri = rg.nonzero()[0]
         if ri.size:
             q = a[ri] - 2 * R
             pos = q >> 1
@@ -541,16 +585,20 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             self._regrasps += rg
         # sub-envs whose last episode ended restart here (next-step autoreset)
         if reset_idx.size:
-            self._reset_subs(reset_idx.tolist(), [None] * reset_idx.size, None, infos)
+            self._autoreset_subs(reset_idx, infos)
+            new_grasp = np.concatenate((ri, reset_idx))
+        else:
+            new_grasp = ri
         self._compute_masks()
         mask = self._mask
         # observation (the GraspGait-v0 table), every row
         o, hd, c, p, k = self._obs, self._head, self._c, self._p, self._k
-        if ri.size:
-            cr = c[ri]
-            hd[ri, _HELD:_HELD + 3] = cr >= 0
-            hd[ri, _PHI:_PHI + 6] = self._phi_cs.take(cr + 1, axis=0).reshape(ri.size, 6)
-            self._write_window(ri)
+        if new_grasp.size:  # rows whose grasp changed: a regrasp or a restart
+            cr = c[new_grasp]
+            hd[new_grasp, _HELD:_HELD + 3] = cr >= 0
+            hd[new_grasp, _PHI:_PHI + 6] = self._phi_cs.take(cr + 1, axis=0).reshape(
+                new_grasp.size, 6)
+            self._write_window(new_grasp)
         hd[:, _POS:_POS + 3] = np.where(p >= 0, p * self._inv_w, -1.0)
         ki = k - self._k_lo  # rows of the per-k tables
         hd[:, _THETA:_TO_GO + 1] = self._k_head.take(ki, axis=0)
@@ -559,6 +607,13 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             lines = o[:, self.layout.lines].reshape(N, 2, n)
             lines[:, 0] = self._lines[c[self._arN, self._f], shift]
             lines[:, 1] = self._lines[c[self._arN, self._g], shift]
+        if self._openings is not None:  # thesis 4.2, 5.2: the regrasps a rotation opens
+            h = self._h[:, None]
+            i = (self._ws_start[h] - k[:, None] - self._rot_delta) % n
+            opens = (self._openings[h, c[self._arN, self._f][:, None], i]
+                     | self._openings[h, c[self._arN, self._g][:, None], i])
+            np.logical_and(opens, mask[:, :2 * R], out=opens)
+            o[:, self.layout.lookahead] = opens
         # episode ends and reward (GraspGaitEnv._reward's table, term by term, same order)
         is_success = self._k_success[ki]
         terminated = live & (self._k_ends[ki] | ~mask.any(axis=1))
@@ -573,7 +628,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         rotation = np.where(rot, -cfg.gamma, 0.0)  # thesis 5.4: - gamma per rotation
         success = np.where(terminated & is_success, cfg.success_bonus, 0.0)
         dead_end = np.where(terminated & ~is_success, -cfg.dead_end_penalty, 0.0)
-        illegal = np.where(live & ~legal, -cfg.illegal_penalty, 0.0)
+        illegal = np.where(live ^ legal, -cfg.illegal_penalty, 0.0)  # legal implies live
         reward = turn + regrasp + rotation + success + dead_end + illegal
         # the time limit (gymnasium's TimeLimit: truncated once elapsed >= the limit)
         self._elapsed += live
@@ -622,14 +677,17 @@ def sample_legal_actions(masks: NDArray[np.bool_], u: NDArray[np.floating]) -> N
     ndarray of int64, shape (N,)
     """
     N, A = masks.shape
-    # legal actions counted through the flattened batch: row i's j-th legal action is
-    # where the running count first exceeds (count before row i) + j
-    count = np.cumsum(masks.ravel(), dtype=np.int32)  # int32: NumPy's fast path
-    ends = count[A - 1::A]  # the running count at each row's end
-    before = np.concatenate(([0], ends[:-1]))
-    pick = before + (u * (ends - before)).astype(np.int32)
-    found = np.searchsorted(count, pick, side="right") - A * np.arange(N)
-    return np.minimum(found, A - 1)
+    # every legal action of the batch as a flat index (row i's lie in [i A, (i + 1) A)),
+    # then one binary search per row for where its legal actions start in that list
+    legal = masks.ravel().nonzero()[0]
+    if legal.size == 0:
+        return np.full(N, A - 1, dtype=np.int64)
+    row_start = np.arange(0, (N + 1) * A, A)
+    bounds = legal.searchsorted(row_start)
+    first = bounds[:-1]
+    count = bounds[1:] - first
+    pick = legal.take(np.minimum(first + (u * count).astype(np.int64), legal.size - 1))
+    return np.where(count > 0, pick - row_start[:-1], A - 1)
 
 
 def _copy_env(env: GraspGaitEnv) -> GraspGaitEnv:

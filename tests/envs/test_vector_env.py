@@ -107,6 +107,9 @@ def test_same_transitions_at_the_registered_time_limit():
     {"map_lines": True, "turn_deg": 40.0},
     {"to_go_weight": 0.5, "turn_deg": 60.0},
     {"contact_model": "hand", "object": "pentagon", "turn_deg": 40.0},
+    {"rotation_lookahead": True, "contact_model": "hand", "object": "hexagon",
+     "turn_deg": 40.0},
+    {"rotation_lookahead": True, "map_lines": True, "turn_deg": -30.0, "n": 90},
 ])
 def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
@@ -183,6 +186,8 @@ def test_bad_inputs_name_the_argument():
         env.step(np.ones(2, dtype=bool))
     with pytest.raises(GraspGaitInputError, match=r"actions\[1\]=182"):
         env.step(np.array([0, 182]))
+    with pytest.raises(GraspGaitInputError, match=r"actions\[0\]=-1"):
+        env.step(np.array([-1, 0]))
     with pytest.raises(GraspGaitInputError, match="reset_mask"):
         env.reset(options={"reset_mask": np.zeros(2, dtype=bool)})
     with pytest.raises(GraspGaitInputError, match="seed="):
@@ -225,3 +230,60 @@ def test_large_grids_read_the_regrasp_runs_from_the_view(monkeypatch):
     env = GraspGaitVectorEnv(2)
     assert env._runs_table is None
     compare_rollouts(3, 5, 60, turn_deg=20.0)
+
+
+def test_sample_legal_actions_is_uniform_over_each_rows_legal_actions():
+    """Row i takes its floor(u_i L_i)-th legal action; a row without one gets A - 1."""
+    rng = np.random.default_rng(5)
+    for density in (0.02, 0.3, 0.9):
+        masks = rng.random((64, 37)) < density
+        masks[[3, 40]] = False  # dead ends
+        u = rng.random(64)
+        got = vector_env.sample_legal_actions(masks, u)
+        for i, (m, x) in enumerate(zip(masks, u, strict=True)):
+            legal = np.flatnonzero(m)
+            want = legal[int(x * legal.size)] if legal.size else 36
+            assert got[i] == want, (density, i)
+    dead = np.zeros((4, 9), dtype=bool)
+    np.testing.assert_array_equal(vector_env.sample_legal_actions(dead, rng.random(4)),
+                                  [8, 8, 8, 8])
+
+
+def test_start_draw_redraws_and_scans_past_starts_without_a_move():
+    """The one start draw of single and batched envs: redraws, then scans from an offset."""
+    from graspgait_env.envs.map_env import _START_TRIES, draw_start_index
+
+    # only start 7 of 50 has a legal move: the redraws usually miss, the scan finds it
+    rng = np.random.default_rng(0)
+    seen = []
+    i = draw_start_index(rng, 50, lambda j: seen.append(j) or j == 7)
+    assert i == 7
+    assert len(seen) > _START_TRIES or seen[-1] == 7
+    assert draw_start_index(np.random.default_rng(0), 50, lambda j: False) is None
+    # the draws are the generator's: same seed, same index
+    a = draw_start_index(np.random.default_rng(3), 50, lambda j: j % 5 == 0)
+    b = draw_start_index(np.random.default_rng(3), 50, lambda j: j % 5 == 0)
+    assert a == b and a % 5 == 0
+
+
+def test_autoreset_draws_the_single_envs_starts_past_dead_end_starts(monkeypatch):
+    """Circle at mu 0.3: 3 of its start grasps have no legal move. With the start list cut
+    to those 3 and 2 others, most draws are redrawn; restarts still match sync."""
+    from graspgait_env.gait import GaitModel
+
+    kw = {"object": "circle", "mu": 0.3, "turn_deg": 6.0, "max_backward_deg": 4.0}
+    full = GaitModel.start_states
+    probe = _batched(1, **kw).unwrapped
+    ok = np.array(probe._start_ok, dtype=bool)
+    assert (~ok).sum() == 3
+    keep = [*np.flatnonzero(~ok)[:3], *np.flatnonzero(ok)[:2]]
+
+    def few_starts(self):
+        starts = full(self)
+        return [starts[i] for i in keep] if len(starts) == ok.size else starts
+
+    monkeypatch.setattr(GaitModel, "start_states", few_starts)
+    a = _batched(4, **kw).unwrapped
+    assert a._start_ok == [False, False, False, True, True]
+    ends = compare_rollouts(4, 3, 150, **kw)
+    assert sum(ends.values()) >= 8  # restarts happened
