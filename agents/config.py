@@ -192,6 +192,12 @@ class TrainConfig:
     """Evaluate every this many environment steps (0: only at the end)."""
     eval_episodes: int = 40
     """Episodes per evaluation, from fixed starts (seeds 10000, 10001, ...)."""
+    best_success_floor: float | None = None
+    """How ``best.zip`` is chosen among the periodic evaluations
+    (:func:`agents.train.selection_score`): None ranks them by success rate over solvable
+    starts, then by fewest regrasps relative to the optimum; a number in [0, 1] ranks
+    those reaching that success rate above the others and, among them, by regrasps
+    relative to the optimum alone (issue 11's acceptance: 0.98, then the fewest regrasps)."""
     checkpoint_freq: int = 50_000
     """Save a checkpoint every this many environment steps (0: none)."""
     seed: int = 0
@@ -262,6 +268,10 @@ class TrainConfig:
         put("total_timesteps", check_count("total_timesteps", self.total_timesteps, 1, 200_000))
         put("eval_freq", check_count("eval_freq", self.eval_freq, 0, 25_000))
         put("eval_episodes", check_count("eval_episodes", self.eval_episodes, 1, 40))
+        if self.best_success_floor is not None:
+            put("best_success_floor", check_number("best_success_floor",
+                                                   self.best_success_floor, 0.98,
+                                                   minimum=0.0, maximum=1.0))
         put("checkpoint_freq", check_count("checkpoint_freq", self.checkpoint_freq, 0, 50_000))
         put("seed", check_count("seed", self.seed, 0, 0))
         if self.torch_threads is None:

@@ -9,8 +9,9 @@ A run lives in its own folder, ``{run_root}/{env_id}-{config name}-s{seed}-{YYYY
 - ``checkpoints/model_{steps}_steps.zip`` (+ ``.json`` cards), every
   ``checkpoint_freq`` steps; ``graspgait train CONFIG --resume`` one of them continues
   the run in the same folder;
-- ``best.zip`` (+ card): the model of the best evaluation (highest success rate over
-  solvable starts, then fewest regrasps relative to the optimum);
+- ``best.zip`` (+ card): the model of the best evaluation (:func:`selection_score`:
+  highest success rate over solvable starts, then fewest regrasps relative to the
+  optimum; with ``best_success_floor``, fewest regrasps among those reaching it);
 - ``model.zip`` + ``model.json``: the final model and its card (:mod:`agents.card`).
 
 The periodic evaluation (every ``eval_freq`` steps and at the end) plays
@@ -47,7 +48,8 @@ from agents.seeding import seed_everything, set_torch_threads
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["TrainResult", "train", "run_name", "build_model", "make_vec_env_for"]
+__all__ = ["TrainResult", "train", "run_name", "build_model", "make_vec_env_for",
+           "selection_score"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,40 @@ class TrainResult:
     steps: int
     wall_s: float
     last_eval: dict[str, Any]
+
+
+def selection_score(summary: dict[str, Any],
+                    success_floor: float | None = None) -> tuple[float, ...]:
+    """The rank of a periodic evaluation for ``best.zip``: the largest score wins.
+
+    Parameters
+    ----------
+    summary
+        :func:`agents.evaluate.summarize_episodes`' numbers (``success_rate_solvable``,
+        ``regrasps_vs_optimal``; None counts as 0 success and infinitely many regrasps).
+    success_floor
+        None: ``(success rate, -regrasps vs optimum)``, success first. A rate in [0, 1]:
+        every evaluation reaching it ranks above every one that does not; among those
+        reaching it the fewest regrasps relative to the optimum win (success no longer
+        counts), below it the rule without a floor applies.
+
+    Examples
+    --------
+    >>> a = {"success_rate_solvable": 1.0, "regrasps_vs_optimal": 1.15}
+    >>> b = {"success_rate_solvable": 0.99, "regrasps_vs_optimal": 1.05}
+    >>> selection_score(a) > selection_score(b)
+    True
+    >>> selection_score(a, 0.98) > selection_score(b, 0.98)
+    False
+    """
+    rate = summary.get("success_rate_solvable") or 0.0
+    ratio = summary.get("regrasps_vs_optimal")
+    fewer = -(ratio if ratio is not None else float("inf"))
+    if success_floor is None:
+        return (rate, fewer)
+    if rate >= success_floor:
+        return (1.0, fewer, rate)
+    return (0.0, rate, fewer)
 
 
 def run_name(config: TrainConfig, when: datetime | None = None) -> str:
@@ -167,7 +203,7 @@ def _callbacks(config: TrainConfig, run_dir: Path, card_base: dict[str, Any],
             path = run_dir / "evaluations.json"
             if path.is_file():  # resumed run: keep the earlier evaluations
                 self.evaluations = json.loads(path.read_text(encoding="utf-8"))
-            self.best: tuple[float, float] | None = None
+            self.best: tuple[float, ...] | None = None
             self.last: dict[str, Any] = {}
             self.bar = None
 
@@ -207,7 +243,7 @@ def _callbacks(config: TrainConfig, run_dir: Path, card_base: dict[str, Any],
                     self.logger.record(f"eval/{key}", summ[key])
             self.logger.dump(steps)
             rate = summ["success_rate_solvable"] or 0.0
-            score = (rate, -(summ["regrasps_vs_optimal"] or float("inf")))
+            score = selection_score(summ, config.best_success_floor)
             if self.best is None or score > self.best:
                 self.best = score
                 save_agent(self.model, run_dir / "best.zip", self.card(steps))

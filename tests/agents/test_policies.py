@@ -1,0 +1,127 @@
+"""The grasp-map features extractor: layout, shapes, save/load with the model zip."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+from agents.card import load_agent, save_agent
+from agents.config import load_train_config
+from agents.policies import GraspMapExtractor, layout_of
+from agents.train import build_model, make_vec_env_for
+from graspgait_env.errors import GraspGaitInputError
+
+_EXTRACTOR = "agents.policies:GraspMapExtractor"
+
+
+def _env(**kw):
+    return gym.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7, **kw)
+
+
+def test_layout_of_matches_the_env_layout():
+    env = _env(map_lines=True, map_window_cells=12)
+    lay = layout_of(env.observation_space, 12, env.unwrapped.model.n)
+    ref = env.unwrapped.layout if hasattr(env.unwrapped, "layout") else None
+    assert lay.size == env.observation_space.shape[0]
+    assert lay.mask.stop - lay.mask.start == env.action_space.n
+    if ref is not None:
+        assert (lay.window, lay.lines) == (ref.window, ref.lines)
+
+
+def test_layout_that_does_not_fit_names_the_fix():
+    env = _env()
+    with pytest.raises(GraspGaitInputError, match="line_cells"):
+        layout_of(env.observation_space, 36, 5000)
+
+
+def test_extractor_reads_each_part_where_the_env_puts_it():
+    env = _env(map_lines=True, map_window_cells=12)
+    n = env.unwrapped.model.n
+    torch.manual_seed(0)
+    ext = GraspMapExtractor(env.observation_space, cells=12, line_cells=n)
+    obs, _ = env.reset(seed=0)
+    x = torch.as_tensor(np.stack([obs, obs]))
+    f = ext(x)
+    lay = ext.layout
+    assert f.shape == (2, ext.features_dim)
+    assert torch.equal(f[:, : lay.window.start], x[:, : lay.window.start])  # header + mask
+    # changing the window changes only the window features, the lines only theirs
+    y = x.clone()
+    y[:, lay.window] = 1.0 - y[:, lay.window]
+    g = ext(y)
+    w0, w1 = lay.window.start, lay.window.start + 64
+    assert torch.equal(g[:, w1:], f[:, w1:]) and not torch.equal(g[:, w0:w1], f[:, w0:w1])
+    z = x.clone()
+    z[:, lay.lines] = torch.roll(z[:, lay.lines].reshape(2, 2, n), 7, dims=2).reshape(2, -1)
+    h = ext(z)
+    assert torch.equal(h[:, :w1], f[:, :w1])
+
+
+def test_without_lines_the_extractor_has_no_line_branch():
+    env = _env()
+    ext = GraspMapExtractor(env.observation_space, cells=36)
+    assert ext.line_net is None
+    assert ext.features_dim == ext.layout.window.start + 64
+
+
+def test_model_with_the_extractor_saves_and_loads_with_identical_actions(tmp_path):
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [
+        f"run_root={tmp_path}", "env_kwargs.map_lines=true", "env_kwargs.map_window_cells=12",
+        f"features_extractor={_EXTRACTOR}",
+        "features_extractor_kwargs={cells: 12, line_cells: 180}"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    model.learn(128)
+    assert isinstance(model.policy.features_extractor, GraspMapExtractor)
+    path = save_agent(model, tmp_path / "m.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
+    loaded, _ = load_agent(path)
+    assert isinstance(loaded.policy.features_extractor, GraspMapExtractor)
+    env = _env(map_lines=True, map_window_cells=12)
+    obs, info = env.reset(seed=3)
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        mask = info["action_mask"]
+        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
+        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
+        assert int(a0) == int(a1) and mask[int(a1)]
+        obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
+        if term or trunc:
+            obs, info = env.reset()
+    for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
+        assert torch.equal(p, q)
+
+
+def test_finishing_rotations_are_the_legal_rotations_that_reach_the_turn():
+    env = _env(map_lines=True, turn_deg=60.0)  # a short turn: finishing grasps come often
+    m = env.unwrapped.model
+    K, R = m.turn_steps(60.0), int(m.R)
+    ext = GraspMapExtractor(env.observation_space, cells=36, line_cells=m.n, conv=False,
+                            turn_steps=K, rotations=R)
+    assert ext.features_dim == env.observation_space.shape[0] + R
+    rng = np.random.default_rng(1)
+    obs, info = env.reset(seed=0)
+    seen = 0
+    for _ in range(200):
+        mask = info["action_mask"]
+        k = env.unwrapped.state.k
+        want = np.array([mask[a] and k + a + 1 >= K for a in range(R)], dtype=np.float32)
+        f = ext(torch.as_tensor(obs[None]))
+        assert torch.equal(f[0, : obs.size], torch.as_tensor(obs))  # conv=False: flat
+        assert np.array_equal(f[0, obs.size:].numpy(), want)
+        seen += int(want.any())
+        # walk towards the goal: the farthest legal rotation, else a random legal move
+        ccw = np.flatnonzero(mask[:R])
+        a = int(ccw[-1]) if ccw.size and rng.random() < 0.7 else int(
+            rng.choice(np.flatnonzero(mask)))
+        obs, _, term, trunc, info = env.step(np.int64(a))
+        if term or trunc:
+            obs, info = env.reset()
+    assert seen > 0  # the walk met grasps from which a rotation finishes
+
+
+def test_finishing_rotations_need_a_fitting_rotation_count():
+    env = _env()
+    with pytest.raises(GraspGaitInputError, match="rotations=500"):
+        GraspMapExtractor(env.observation_space, turn_steps=180, rotations=500)
