@@ -1,0 +1,75 @@
+"""Batched evaluation: the same records as one episode after another, faster."""
+
+from __future__ import annotations
+
+import pytest
+
+from agents.card import load_agent
+from agents.envs import make_env
+from agents.evaluate import (
+    ReferenceGaits,
+    agent_batch_predictor,
+    agent_predictor,
+    batched_eval_env,
+    evaluate,
+    run_episodes,
+    run_episodes_batched,
+)
+
+
+def _strip(records):
+    return [{k: v for k, v in r.items() if k != "wall_s"} for r in records]
+
+
+@pytest.mark.parametrize("name", ["ellipse", "hexagon"])
+def test_batched_records_equal_the_serial_ones_for_a_shipped_agent(name):
+    """Starts, success, regrasps, moves and references: episode for episode, across waves
+    (7 episodes in waves of 3) and for the hexagon's look-ahead observation."""
+    from agents.bench import shipped_models_dir
+
+    path = shipped_models_dir() / f"{name}.zip"
+    if not path.is_file():
+        pytest.skip(f"{path} is not there yet")
+    model, card = load_agent(path)
+    kwargs = card["env_kwargs"]
+    refs = ReferenceGaits()
+    serial = run_episodes(agent_predictor(model), make_env("GraspGait-v0", kwargs), 7, 321,
+                          refs)
+    venv = batched_eval_env("GraspGait-v0", kwargs, (), 3)
+    batched = run_episodes_batched(agent_batch_predictor(model), venv, 7, 321, refs)
+    assert _strip(batched) == _strip(serial)
+    assert any(r["success"] for r in serial)  # the agent does play its gait here
+
+
+def test_batched_counts_illegal_actions_as_the_serial_loop():
+    """A plain PPO policy (no masks), untrained: illegal no-ops and the 500-step limit."""
+    import torch
+    from stable_baselines3 import PPO
+
+    torch.set_num_threads(1)
+    env = make_env("GraspGait-v0", {"object": "circle", "map_window_cells": 4})
+    model = PPO("MlpPolicy", env, seed=3, device="cpu")
+    serial = run_episodes(agent_predictor(model), env, 3, 0)
+    venv = batched_eval_env("GraspGait-v0", {"object": "circle", "map_window_cells": 4}, (), 2)
+    batched = run_episodes_batched(agent_batch_predictor(model), venv, 3, 0)
+    assert _strip(batched) == _strip(serial)
+    assert sum(r["illegal_actions"] for r in serial) > 0
+    for r in batched:
+        assert r["path_length"] == r["steps"] - r["illegal_actions"]
+
+
+def test_batched_env_only_where_it_reproduces_the_env():
+    assert batched_eval_env("GraspGaitMujoco-v1", {"object": "circle"}) is None
+    assert batched_eval_env("GraspGaitRandom-v0", {}) is None
+    assert batched_eval_env("GraspGait-v0", {"object": "circle"},
+                            ("agents.wrappers:LegalActionWrapper",)) is None
+    venv = batched_eval_env("GraspGait-v0", {"object": "circle"}, (), 5)
+    assert venv.num_envs == 5
+
+
+def test_evaluate_sampled_actions_stay_one_by_one(smoke_run):
+    """Sampled actions draw torch's random numbers episode after episode: same seed,
+    same records (the batched path is for greedy actions only)."""
+    a = evaluate(smoke_run.model_path, episodes=3, seed=2, deterministic=False)
+    b = evaluate(smoke_run.model_path, episodes=3, seed=2, deterministic=False)
+    assert _strip(a["episodes"]) == _strip(b["episodes"])
