@@ -246,6 +246,14 @@ class GraspGaitConfig:
     (``2 R`` entries, 1: the rotation opens at least one regrasp; a one-step look-ahead
     of the legal-move function of thesis 4.2 and 5.2, not the optimum's regrasps to go;
     see the env's *Observation Space*). False (the default): no look-ahead."""
+    forbid_reversal: bool = False
+    """After a rotation, make the rotations the other way illegal until the next regrasp
+    (True; beyond the thesis), so that a policy cannot rock the object back and forth
+    without ever regrasping. No gait needs such a reversal: a rotation by ``a`` followed
+    by one by ``-b`` is the single rotation by ``a - b``, legal whenever both were (its
+    path lies within theirs, thesis 5.2), with the same regrasps and fewer rotations; so
+    the fewest regrasps from every state, and every planner's gait, are unchanged
+    (tested). False (the default): every rotation of ``model.action_mask`` is legal."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -286,6 +294,10 @@ class GraspGaitConfig:
             raise GraspGaitInputError(
                 f"rotation_lookahead={self.rotation_lookahead!r}: must be True or False")
         put("rotation_lookahead", bool(self.rotation_lookahead))
+        if not isinstance(self.forbid_reversal, (bool, np.bool_)):
+            raise GraspGaitInputError(
+                f"forbid_reversal={self.forbid_reversal!r}: must be True or False")
+        put("forbid_reversal", bool(self.forbid_reversal))
         from graspgait_env.contact_model import CONTACT_MODELS
 
         if self.contact_model not in CONTACT_MODELS:

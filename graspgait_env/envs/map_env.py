@@ -345,7 +345,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
       ``turn_deg`` (``sigma θ >= abs(T)``).
     - **Dead end** (terminated, ``is_success = False``): no legal move remains. (Every
       thesis move can be undone, so with ``GaitModel``'s moves this cannot follow a legal
-      move; starts without a legal move are never drawn. The check stays for safety.)
+      move; starts without a legal move are never drawn. With ``forbid_reversal`` it
+      can: a rotation to an angle where no regrasp is legal and only rotations back
+      are.)
     - **Wrong way** (terminated, ``is_success = False``): the object has turned more
       than ``max_backward_deg`` against the goal (bounds the observation; the gait graph
       repeats every 360°, so nothing is lost beyond one full turn back).
@@ -360,7 +362,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     units): ``hand=None, turn_deg=360.0, n=180, alpha=1.0, beta=0.01, gamma=0.01,
     turn_scale_deg=None, success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1,
     to_go_weight=0.0, max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36,
-    map_lines=False, contact_model="point", rotation_lookahead=False``.
+    map_lines=False, contact_model="point", rotation_lookahead=False,
+    forbid_reversal=False``.
 
     - ``object``: bundled name (``"ellipse"``, the thesis's fig. 5.3 ellipse), YAML path
       or :class:`~graspgait_env.shapes.Shape`.
@@ -379,6 +382,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     - ``contact_model``: ``"point"`` (the thesis's) or ``"hand"`` (the simulated hand's
       ball tips; see :class:`~graspgait_env.envs.config.GraspGaitConfig`).
     - ``rotation_lookahead``: append the rotation look-ahead (above).
+    - ``forbid_reversal``: after a rotation, no rotation the other way until the next
+      regrasp (:class:`~graspgait_env.envs.config.GraspGaitConfig`; the legal actions are
+      then ``model.action_mask`` less those rotations).
     - ``render_mode``: ``"rgb_array"`` returns a ``(480, 640, 3)`` uint8 frame: the
       object in the workspace frame with the three workspaces and the fingers, and the
       extended grasp map (finger pair boxes at the present θ) with the gait so far
@@ -566,11 +572,22 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._h = 3 - self._f - self._g  # the free finger
         # workspace position of each finger's contact (GaitModel.position; -1: free)
         self._p = [self.model.position(f, c[f], k) if c[f] >= 0 else -1 for f in range(3)]
+        self._last_turn = 0  # sign of the last move if a rotation, else 0 (forbid_reversal)
+
+    _last_turn = 0  # set by _set_state and step
 
     def _compute_mask(self) -> NDArray[np.bool_]:
         """The legal moves of the present state: ``model.action_mask`` (THE legal-move
-        function; a fresh array each call)."""
-        return self.model.action_mask(GaitState(self._k, self._c))
+        function; a fresh array each call), less, with ``forbid_reversal``, the rotations
+        against the last move when it was a rotation."""
+        mask = self.model.action_mask(GaitState(self._k, self._c))
+        if self._last_turn and self.config.forbid_reversal:
+            R = self.model.R
+            if self._last_turn > 0:
+                mask[R:2 * R] = False  # clockwise after counter-clockwise
+            else:
+                mask[:R] = False
+        return mask
 
     # ------------------------------------------------------------------ observation
     def _write_grasp(self) -> None:
@@ -791,6 +808,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 self._p[self._f] += d
                 self._p[self._g] += d
                 self._rotations += 1
+                self._last_turn = 1 if d > 0 else -1
             else:  # regrasp: the free finger to m.contact, m.lifted lifted (GaitModel.decode)
                 move = REGRASP
                 m = self.model.decode(GaitState(k0, self._c), a)
@@ -805,6 +823,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 self._f, self._g = (h, kept) if h < kept else (kept, h)
                 self._h = lifted
                 self._regrasps += 1
+                self._last_turn = 0
                 self._write_grasp()
                 if self._to_go is not None:
                     before, self._togo_now = self._togo_now, self._to_go(GaitState(k0, self._c))

@@ -50,6 +50,7 @@ SUPPORTED_FIELDS: frozenset[str] = frozenset({
     "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
     "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
     "map_window_deg", "map_window_cells", "map_lines", "contact_model", "rotation_lookahead",
+    "forbid_reversal",
 })
 
 
@@ -280,6 +281,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._h = np.full(N, 2, dtype=np.int64)
         self._mask = np.zeros((N, A), dtype=bool)
         self._regrasps = np.zeros(N, dtype=np.int64)
+        # forbid_reversal: sign of each sub-env's last move if a rotation, else 0
+        self._forbid_reversal = bool(self.config.forbid_reversal)
+        self._last_turn = np.zeros(N, dtype=np.int64)
         self._elapsed = np.zeros(N, dtype=np.int64)
         self._autoreset = np.zeros(N, dtype=bool)
         self._obs = np.zeros((N, self.layout.size), dtype=np.float32)
@@ -387,6 +391,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         p = (c + self._k[idx, None] - self._ws_start) % self._n
         self._p[idx] = np.where(c >= 0, p, -1)
         self._regrasps[idx] = 0
+        self._last_turn[idx] = 0
         if self._to_go is not None:
             from graspgait_env.gait import GaitState
 
@@ -526,6 +531,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # interleaved: keep g (lift f, l = 0) at even slots, keep f (lift g, l = 1) at odd
         np.logical_and(run_g, valid, out=mask[:, b::2])
         np.logical_and(run_f, valid, out=mask[:, b + 1::2])
+        if self._forbid_reversal:  # no rotation against the last move if it was one
+            mask[self._last_turn > 0, R:2 * R] = False
+            mask[self._last_turn < 0, :R] = False
 
     def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
         """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
@@ -566,6 +574,8 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # rotations (thesis 5.2): both contacts move d grid steps through their workspaces
         dk = np.where(rot, d, 0)
         self._k += dk
+        if self._forbid_reversal:  # the last move's direction if a rotation, else 0
+            self._last_turn[legal] = np.sign(dk[legal])
         self._p += dk[:, None] * (self._c >= 0)
         # regrasps (thesis 4.2): the free finger h to position p, the lifted finger freed
         ri = rg.nonzero()[0]

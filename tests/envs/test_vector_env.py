@@ -56,7 +56,10 @@ def masked_actions(masks: np.ndarray, rng: np.random.Generator,
         return rng.integers(0, masks.shape[1], masks.shape[0])
     counts = masks.sum(axis=1)
     pick = (rng.random(masks.shape[0]) * counts).astype(np.int64)
-    return np.array([np.flatnonzero(m)[j] for m, j in zip(masks, pick, strict=True)])
+    # a row with no legal move (a dead end, e.g. with forbid_reversal) is reset on the
+    # next step whatever the action
+    return np.array([np.flatnonzero(m)[j] if m.any() else 0
+                     for m, j in zip(masks, pick, strict=True)])
 
 
 def compare_rollouts(num_envs: int, seed: int, steps: int, **kw) -> dict[str, int]:
@@ -110,6 +113,9 @@ def test_same_transitions_at_the_registered_time_limit():
     {"rotation_lookahead": True, "contact_model": "hand", "object": "hexagon",
      "turn_deg": 40.0},
     {"rotation_lookahead": True, "map_lines": True, "turn_deg": -30.0, "n": 90},
+    {"forbid_reversal": True, "rotation_lookahead": True, "turn_deg": 60.0},
+    {"forbid_reversal": True, "contact_model": "hand", "object": "hexagon",
+     "to_go_weight": 1.0, "turn_deg": 40.0},
 ])
 def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
