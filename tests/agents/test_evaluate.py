@@ -183,3 +183,31 @@ def test_evaluate_on_the_mujoco_hand(smoke_run):
     (ep,) = res["episodes"]
     assert ep["steps"] < 500 and ep["illegal_actions"] == 0
     assert ep["path_length"] >= 1
+
+
+@pytest.mark.parametrize("obj, hand, turn, n", [
+    ("ellipse", False, 360.0, 90), ("pentagon", True, 360.0, 90),
+    ("hexagon", True, 360.0, 180), ("triangle", False, 360.0, 90),
+    ("ellipse", True, -200.0, 90),
+])
+def test_the_optimum_table_equals_the_exact_planner_start_by_start(obj, hand, turn, n):
+    """ReferenceGaits reads the optimum from one table per model; from every sampled
+    start (with and without a gait) it is what optimal_gait reports."""
+    from graspgait_env.contact_model import hand_contact_model
+    from graspgait_env.gait import GaitModel
+
+    kw = {"contact_model": hand_contact_model(obj)} if hand else {}
+    model = GaitModel(obj, 0.7, n=n, **kw)
+    refs = ReferenceGaits()
+    starts = model.start_states()
+    checked = {True: 0, False: 0}
+    for s in starts[:: max(1, len(starts) // 24)]:
+        res = optimal_gait(model, s, turn)
+        assert refs.optimal_regrasps(model, s, turn) == (res.regrasps if res.success
+                                                          else None)
+        checked[res.success] += 1
+    assert checked[True] + checked[False] >= 20
+    if obj == "triangle":  # no gait at mu 0.7: the table says so too
+        assert checked[False] > 0
+    else:
+        assert checked[True] > 0
