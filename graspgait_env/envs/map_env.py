@@ -405,7 +405,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     ## Version History
 
-    - v0: initial version.
+    - v0: initial version. Opt-in fields added since, each off by default (tested), so
+      the defaults behave as before: ``to_go_weight``, ``map_lines``,
+      ``contact_model``, ``rotation_lookahead``, ``forbid_reversal``.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"],
