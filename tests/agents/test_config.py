@@ -89,3 +89,20 @@ def test_torch_threads_follow_the_machine():
     assert [default_torch_threads(c) for c in (1, 2, 4, 8, 16, 64)] == [1, 1, 1, 2, 4, 4]
     assert TrainConfig().torch_threads == default_torch_threads()
     assert TrainConfig(torch_threads=3).torch_threads == 3
+
+
+@pytest.mark.parametrize("name", ["circle", "ellipse", "pentagon", "hexagon", "random"])
+def test_each_shipped_model_card_holds_its_bundled_config(name):
+    """`graspgait train NAME` trains the shipped model's config: the bundled YAML and the
+    config in `agents/models/NAME.json` make the same TrainConfig (a field added after
+    a card was written takes its default)."""
+    import json
+
+    from agents.bench import shipped_models_dir
+
+    card = shipped_models_dir() / f"{name}.json"
+    if not card.is_file():
+        pytest.skip(f"{card} is not there")
+    shipped = json.loads(card.read_text(encoding="utf-8"))
+    assert load_train_config(name) == TrainConfig(**shipped["config"])
+    assert shipped["env_kwargs"] == shipped["config"]["env_kwargs"]
