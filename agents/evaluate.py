@@ -75,7 +75,9 @@ class ReferenceGaits:
     the window of :func:`~graspgait_env.planners.exact.optimal_gait` (one full turn
     against the requested one), so it equals ``optimal_gait(model, start,
     turn_deg).regrasps`` (tested) at the cost of one search per model instead of one
-    per start: 100 ellipse starts took 44 s one by one, about 1 s with the table.
+    per start (measured: 100 ellipse starts cost 44 s of exact searches one by one;
+    ``graspgait evaluate`` of the shipped hexagon agent, 100 episodes, went from 72 s
+    to 14 s with the same records).
     """
 
     def __init__(self) -> None:
