@@ -576,8 +576,6 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._p = [self.model.position(f, c[f], k) if c[f] >= 0 else -1 for f in range(3)]
         self._last_turn = 0  # sign of the last move if a rotation, else 0 (forbid_reversal)
 
-    _last_turn = 0  # set by _set_state and step
-
     def _compute_mask(self) -> NDArray[np.bool_]:
         """The legal moves of the present state: ``model.action_mask`` (THE legal-move
         function; a fresh array each call), less, with ``forbid_reversal``, the rotations
