@@ -254,6 +254,18 @@ class GraspGaitConfig:
     path lies within theirs, thesis 5.2), with the same regrasps and fewer rotations; so
     the fewest regrasps from every state, and every planner's gait, are unchanged
     (tested). False (the default): every rotation of ``model.action_mask`` is legal."""
+    forbid_revisit: bool = False
+    """Make every move to a state already visited in this episode illegal (True; beyond
+    the thesis, whose best-first search never expands a node twice, 5.3), so that a
+    deterministic policy cannot cycle (a regrasp and its undo, a rotation back and
+    forth) until the time limit. A state is the object angle with the contacts
+    (:class:`~graspgait_env.gait.GaitState`). The fewest regrasps from the start are
+    unchanged: a gait that revisits a state contains a cycle, and cutting it out leaves a
+    gait with no more regrasps that visits every state once, legal step by step (tested
+    with every planner's gait). Later in an episode the fewest regrasps from the present
+    state can grow (the way back is closed), and a dead end can follow a legal move
+    (every move leads to a visited state). False (the default): the moves of
+    ``model.action_mask``."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -298,6 +310,10 @@ class GraspGaitConfig:
             raise GraspGaitInputError(
                 f"forbid_reversal={self.forbid_reversal!r}: must be True or False")
         put("forbid_reversal", bool(self.forbid_reversal))
+        if not isinstance(self.forbid_revisit, (bool, np.bool_)):
+            raise GraspGaitInputError(
+                f"forbid_revisit={self.forbid_revisit!r}: must be True or False")
+        put("forbid_revisit", bool(self.forbid_revisit))
         from graspgait_env.contact_model import CONTACT_MODELS
 
         if self.contact_model not in CONTACT_MODELS:

@@ -210,7 +210,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     |                   | finger with the lower (``l = 0``) or higher (``l = 1``) number  |
 
     Legal actions: :meth:`action_masks` (the sb3-contrib ``MaskablePPO`` protocol) and
-    ``info["action_mask"]`` give exactly ``model.action_mask(state)`` (a bool array).
+    ``info["action_mask"]`` give exactly ``model.action_mask(state)`` (a bool array),
+    less, where the opt-in ``forbid_reversal`` and ``forbid_revisit`` are set, the moves
+    they forbid (*Arguments*).
     **An illegal action** (a valid index that is not a legal move) leaves the state as it
     is and costs the ``illegal`` reward term; it never raises. An action is a Python
     ``int``, a NumPy integer (what SB3 and Gymnasium vector envs pass) or a 0-d integer
@@ -347,7 +349,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
       thesis move can be undone, so with ``GaitModel``'s moves this cannot follow a legal
       move; starts without a legal move are never drawn. With ``forbid_reversal`` it
       can: a rotation to an angle where no regrasp is legal and only rotations back
-      are.)
+      are; with ``forbid_revisit`` too: every move leads to a state of this episode.)
     - **Wrong way** (terminated, ``is_success = False``): the object has turned more
       than ``max_backward_deg`` against the goal (bounds the observation; the gait graph
       repeats every 360°, so nothing is lost beyond one full turn back).
@@ -363,7 +365,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     turn_scale_deg=None, success_bonus=1.0, dead_end_penalty=1.0, illegal_penalty=0.1,
     to_go_weight=0.0, max_backward_deg=360.0, map_window_deg=360.0, map_window_cells=36,
     map_lines=False, contact_model="point", rotation_lookahead=False,
-    forbid_reversal=False``.
+    forbid_reversal=False, forbid_revisit=False``.
 
     - ``object``: bundled name (``"ellipse"``, the thesis's fig. 5.3 ellipse), YAML path
       or :class:`~graspgait_env.shapes.Shape`.
@@ -385,6 +387,10 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     - ``forbid_reversal``: after a rotation, no rotation the other way until the next
       regrasp (:class:`~graspgait_env.envs.config.GraspGaitConfig`; the legal actions are
       then ``model.action_mask`` less those rotations).
+    - ``forbid_revisit``: no move to a state (object angle and contacts) already visited
+      in this episode (:class:`~graspgait_env.envs.config.GraspGaitConfig`; a
+      deterministic policy cannot cycle; the fewest regrasps from the start are
+      unchanged).
     - ``render_mode``: ``"rgb_array"`` returns a ``(480, 640, 3)`` uint8 frame: the
       object in the workspace frame with the three workspaces and the fingers, and the
       extended grasp map (finger pair boxes at the present θ) with the gait so far
@@ -407,7 +413,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     - v0: initial version. Opt-in fields added since, each off by default (tested), so
       the defaults behave as before: ``to_go_weight``, ``map_lines``,
-      ``contact_model``, ``rotation_lookahead``, ``forbid_reversal``.
+      ``contact_model``, ``rotation_lookahead``, ``forbid_reversal``,
+      ``forbid_revisit``.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"],
@@ -575,6 +582,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         # workspace position of each finger's contact (GaitModel.position; -1: free)
         self._p = [self.model.position(f, c[f], k) if c[f] >= 0 else -1 for f in range(3)]
         self._last_turn = 0  # sign of the last move if a rotation, else 0 (forbid_reversal)
+        # forbid_revisit: the states visited this episode, contacts -> object angles
+        self._visited = {self._c: {self._k}} if self.config.forbid_revisit else None
 
     def _compute_mask(self) -> NDArray[np.bool_]:
         """The legal moves of the present state: ``model.action_mask`` (THE legal-move
@@ -587,7 +596,29 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 mask[R:2 * R] = False  # clockwise after counter-clockwise
             else:
                 mask[:R] = False
+        if self._visited is not None:
+            self._drop_revisits(mask)
         return mask
+
+    def _drop_revisits(self, mask: NDArray[np.bool_]) -> None:
+        """``forbid_revisit``: clear, in place, the legal moves of ``mask`` that lead to a
+        state visited in this episode. ``_visited`` maps contacts to the object angles
+        (grid steps) visited with them; a rotation keeps the contacts, a regrasp the
+        angle."""
+        k, c, visited = self._k, self._c, self._visited
+        ks = visited[c]
+        nrot = self._rot_delta.size
+        if len(ks) > 1:  # other angles visited with these contacts: rotations to them
+            rot = np.flatnonzero(mask[:nrot])
+            back = np.isin(k + self._rot_delta[rot], np.fromiter(ks, np.int64, len(ks)))
+            mask[rot[back]] = False
+        if len(visited) == 1:  # no other grasp visited yet: every regrasp is to a new state
+            return
+        s = GaitState(k, c)
+        for a in np.flatnonzero(mask[nrot:]) + nrot:
+            c2 = self.model.apply(s, int(a)).contacts
+            if k in visited.get(tuple(int(x) for x in c2), ()):
+                mask[a] = False
 
     # ------------------------------------------------------------------ observation
     def _write_grasp(self) -> None:
@@ -829,6 +860,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                     before, self._togo_now = self._togo_now, self._to_go(GaitState(k0, self._c))
                     # both -1 when no gait exists from here: nothing gained
                     self._gained = before - self._togo_now
+            if self._visited is not None:
+                self._visited.setdefault(self._c, set()).add(self._k)
             self._mask = self._compute_mask()
             self._write_motion()
             if self.render_mode is not None:

@@ -50,7 +50,7 @@ SUPPORTED_FIELDS: frozenset[str] = frozenset({
     "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
     "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
     "map_window_deg", "map_window_cells", "map_lines", "contact_model", "rotation_lookahead",
-    "forbid_reversal",
+    "forbid_reversal", "forbid_revisit",
 })
 
 
@@ -143,11 +143,13 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     each row, ``rotation_lookahead`` the rotation look-ahead, ``contact_model`` changes
     the shared gait model, ``to_go_weight`` looks up the optimum's regrasps to go of
     each sub-env that regrasps, one at a time (this opt-in reward slows the batched
-    step). A field added to the config later
-    (:data:`SUPPORTED_FIELDS` does not list it) is accepted at its default and raises
-    ``ValueError`` naming it otherwise. ``render_mode`` must be None: the batched env
-    draws nothing (make a single env with ``render_mode="rgb_array"`` to watch one
-    episode).
+    step), ``forbid_reversal`` and ``forbid_revisit`` remove the same moves from the
+    masks as the single env (``forbid_revisit`` keeps each sub-env's visited states in
+    a Python set and checks them row by row, so it slows the batched step too). A
+    field added to the config later (:data:`SUPPORTED_FIELDS` does not list it) is
+    accepted at its default and raises ``ValueError`` naming it otherwise.
+    ``render_mode`` must be None: the batched env draws nothing (make a single env with
+    ``render_mode="rgb_array"`` to watch one episode).
 
     ## Version History
 
@@ -284,6 +286,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # forbid_reversal: sign of each sub-env's last move if a rotation, else 0
         self._forbid_reversal = bool(self.config.forbid_reversal)
         self._last_turn = np.zeros(N, dtype=np.int64)
+        # forbid_revisit: per sub-env, the states visited this episode (contacts -> angles)
+        self._visited: list[dict[tuple[int, ...], set[int]]] | None = (
+            [{} for _ in range(N)] if self.config.forbid_revisit else None)
         self._elapsed = np.zeros(N, dtype=np.int64)
         self._autoreset = np.zeros(N, dtype=bool)
         self._obs = np.zeros((N, self.layout.size), dtype=np.float32)
@@ -392,6 +397,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._p[idx] = np.where(c >= 0, p, -1)
         self._regrasps[idx] = 0
         self._last_turn[idx] = 0
+        if self._visited is not None:
+            for i in idx.tolist():
+                self._visited[i] = {tuple(self._c[i].tolist()): {int(self._k[i])}}
         if self._to_go is not None:
             from graspgait_env.gait import GaitState
 
@@ -534,6 +542,31 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         if self._forbid_reversal:  # no rotation against the last move if it was one
             mask[self._last_turn > 0, R:2 * R] = False
             mask[self._last_turn < 0, :R] = False
+        if self._visited is not None:
+            for i in range(self.num_envs):
+                self._drop_revisits(i)
+
+    def _drop_revisits(self, i: int) -> None:
+        """``forbid_revisit``: clear the moves of sub-env ``i``'s mask row that lead to a
+        state visited in its episode (the single env's ``_drop_revisits``, row by row)."""
+        vis, row, nrot = self._visited[i], self._mask[i], 2 * self._R
+        k, c = int(self._k[i]), tuple(self._c[i].tolist())
+        ks = vis[c]
+        if len(ks) > 1:  # other angles visited with these contacts: rotations to them
+            rot = np.flatnonzero(row[:nrot])
+            back = np.isin(k + self._rot_delta[rot], np.fromiter(ks, np.int64, len(ks)))
+            row[rot[back]] = False
+        if len(vis) == 1:  # no other grasp visited yet: every regrasp is to a new state
+            return
+        h = int(self._h[i])
+        for a in (np.flatnonzero(row[nrot:]) + nrot).tolist():
+            q = a - nrot
+            lifted = int(self._regrasp_lifted[2 * h + (q & 1)])
+            c2 = list(c)
+            c2[h] = int((self._ws_start[h] + (q >> 1) - k) % self._n)
+            c2[lifted] = -1
+            if k in vis.get(tuple(c2), ()):
+                row[a] = False
 
     def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
         """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
@@ -593,6 +626,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             self._g[ri] = self._regrasp_g[move]
             self._h[ri] = lifted
             self._regrasps += rg
+        if self._visited is not None:  # forbid_revisit: the states moved to
+            for i in legal.nonzero()[0].tolist():
+                self._visited[i].setdefault(tuple(self._c[i].tolist()), set()).add(
+                    int(self._k[i]))
         # sub-envs whose last episode ended restart here (next-step autoreset)
         if reset_idx.size:
             self._autoreset_subs(reset_idx, infos)

@@ -116,6 +116,9 @@ def test_same_transitions_at_the_registered_time_limit():
     {"forbid_reversal": True, "rotation_lookahead": True, "turn_deg": 60.0},
     {"forbid_reversal": True, "contact_model": "hand", "object": "hexagon",
      "to_go_weight": 1.0, "turn_deg": 40.0},
+    {"forbid_revisit": True, "turn_deg": 60.0},
+    {"forbid_revisit": True, "forbid_reversal": True, "contact_model": "hand",
+     "object": "hexagon", "to_go_weight": 1.0, "turn_deg": 40.0},
 ])
 def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
