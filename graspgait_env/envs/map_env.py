@@ -40,7 +40,11 @@ __all__ = [
     "ObservationLayout",
     "REWARD_TERMS",
     "ResetNeededError",
+    "Visits",
+    "drop_revisits",
+    "new_visits",
     "regrasp_openings",
+    "visit_state",
     "state_from_observation",
 ]
 
@@ -136,6 +140,52 @@ def _pooled_map(stable: NDArray[np.bool_], s: int) -> NDArray[np.float32]:
     out = np.tile((box / (s * s)).astype(np.float32), (2, 2))
     out.flags.writeable = False
     return out
+
+
+Visits = tuple[dict[tuple[int, ...], set[int]], dict[int, set[tuple[int, ...]]]]
+"""The states visited in an episode (``forbid_revisit``), indexed twice: contacts ->
+object angles (grid steps) visited with them, and object angle -> contacts."""
+
+
+def new_visits(k: int, contacts: tuple[int, ...]) -> Visits:
+    """The visits of an episode that starts at angle ``k`` with ``contacts``."""
+    return {contacts: {k}}, {k: {contacts}}
+
+
+def visit_state(visits: Visits, k: int, contacts: tuple[int, ...]) -> None:
+    """Record a visit of the state ``(k, contacts)`` (``contacts`` a tuple of ints)."""
+    visits[0].setdefault(contacts, set()).add(k)
+    visits[1].setdefault(k, set()).add(contacts)
+
+
+def drop_revisits(model: GaitModel, mask: NDArray[np.bool_], k: int,
+                  contacts: tuple[int, ...], by_contacts: dict[tuple[int, ...], set[int]],
+                  by_angle: dict[int, set[tuple[int, ...]]]) -> None:
+    """``forbid_revisit``: clear, in place, the moves of ``mask`` (the legal moves of the
+    state ``(k, contacts)``) that lead to a visited state.
+
+    A rotation keeps the contacts and a regrasp the angle, so only the angles visited
+    with these contacts and the grasps visited at this angle are looked at, each
+    mapped to the one action that reaches it (:meth:`GaitModel.encode`); the cost grows
+    with those visits, not with the legal moves.
+    """
+    s = GaitState(k, contacts)
+    R = model.R
+    for k2 in by_contacts.get(contacts, ()):
+        d = k2 - k
+        if 0 < d <= R:
+            mask[d - 1] = False
+        elif 0 < -d <= R:
+            mask[R - d - 1] = False
+    for c2 in by_angle.get(k, ()):
+        if c2 == contacts:
+            continue
+        try:
+            a = model.encode(s, GaitState(k, c2))
+        except ValueError:  # no one regrasp reaches that grasp
+            continue
+        if mask[a] and model.apply(s, a).contacts == c2:  # encode reads the new contact only
+            mask[a] = False
 
 
 def regrasp_openings(model: GaitModel) -> NDArray[np.bool_]:
@@ -582,8 +632,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         # workspace position of each finger's contact (GaitModel.position; -1: free)
         self._p = [self.model.position(f, c[f], k) if c[f] >= 0 else -1 for f in range(3)]
         self._last_turn = 0  # sign of the last move if a rotation, else 0 (forbid_reversal)
-        # forbid_revisit: the states visited this episode, contacts -> object angles
-        self._visited = {self._c: {self._k}} if self.config.forbid_revisit else None
+        # forbid_revisit: the states visited this episode (visit_state's two indexes)
+        self._visited = new_visits(self._k, self._c) if self.config.forbid_revisit else None
 
     def _compute_mask(self) -> NDArray[np.bool_]:
         """The legal moves of the present state: ``model.action_mask`` (THE legal-move
@@ -597,28 +647,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             else:
                 mask[:R] = False
         if self._visited is not None:
-            self._drop_revisits(mask)
+            drop_revisits(self.model, mask, self._k, self._c, *self._visited)
         return mask
-
-    def _drop_revisits(self, mask: NDArray[np.bool_]) -> None:
-        """``forbid_revisit``: clear, in place, the legal moves of ``mask`` that lead to a
-        state visited in this episode. ``_visited`` maps contacts to the object angles
-        (grid steps) visited with them; a rotation keeps the contacts, a regrasp the
-        angle."""
-        k, c, visited = self._k, self._c, self._visited
-        ks = visited[c]
-        nrot = self._rot_delta.size
-        if len(ks) > 1:  # other angles visited with these contacts: rotations to them
-            rot = np.flatnonzero(mask[:nrot])
-            back = np.isin(k + self._rot_delta[rot], np.fromiter(ks, np.int64, len(ks)))
-            mask[rot[back]] = False
-        if len(visited) == 1:  # no other grasp visited yet: every regrasp is to a new state
-            return
-        s = GaitState(k, c)
-        for a in np.flatnonzero(mask[nrot:]) + nrot:
-            c2 = self.model.apply(s, int(a)).contacts
-            if k in visited.get(tuple(int(x) for x in c2), ()):
-                mask[a] = False
 
     # ------------------------------------------------------------------ observation
     def _write_grasp(self) -> None:
@@ -861,7 +891,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                     # both -1 when no gait exists from here: nothing gained
                     self._gained = before - self._togo_now
             if self._visited is not None:
-                self._visited.setdefault(self._c, set()).add(self._k)
+                visit_state(self._visited, self._k, self._c)
             self._mask = self._compute_mask()
             self._write_motion()
             if self.render_mode is not None:

@@ -33,7 +33,11 @@ from graspgait_env.envs.map_env import (
     REWARD_TERMS,
     GraspGaitEnv,
     ResetNeededError,
+    Visits,
     draw_start_index,
+    drop_revisits,
+    new_visits,
+    visit_state,
 )
 from graspgait_env.envs.registration import MAX_EPISODE_STEPS
 from graspgait_env.errors import GraspGaitInputError
@@ -286,9 +290,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # forbid_reversal: sign of each sub-env's last move if a rotation, else 0
         self._forbid_reversal = bool(self.config.forbid_reversal)
         self._last_turn = np.zeros(N, dtype=np.int64)
-        # forbid_revisit: per sub-env, the states visited this episode (contacts -> angles)
-        self._visited: list[dict[tuple[int, ...], set[int]]] | None = (
-            [{} for _ in range(N)] if self.config.forbid_revisit else None)
+        # forbid_revisit: per sub-env, the states visited this episode (map_env.Visits)
+        self._visited: list[Visits] | None = (
+            [new_visits(0, ()) for _ in range(N)] if self.config.forbid_revisit else None)
         self._elapsed = np.zeros(N, dtype=np.int64)
         self._autoreset = np.zeros(N, dtype=bool)
         self._obs = np.zeros((N, self.layout.size), dtype=np.float32)
@@ -399,7 +403,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._last_turn[idx] = 0
         if self._visited is not None:
             for i in idx.tolist():
-                self._visited[i] = {tuple(self._c[i].tolist()): {int(self._k[i])}}
+                self._visited[i] = new_visits(int(self._k[i]), tuple(self._c[i].tolist()))
         if self._to_go is not None:
             from graspgait_env.gait import GaitState
 
@@ -542,31 +546,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         if self._forbid_reversal:  # no rotation against the last move if it was one
             mask[self._last_turn > 0, R:2 * R] = False
             mask[self._last_turn < 0, :R] = False
-        if self._visited is not None:
-            for i in range(self.num_envs):
-                self._drop_revisits(i)
-
-    def _drop_revisits(self, i: int) -> None:
-        """``forbid_revisit``: clear the moves of sub-env ``i``'s mask row that lead to a
-        state visited in its episode (the single env's ``_drop_revisits``, row by row)."""
-        vis, row, nrot = self._visited[i], self._mask[i], 2 * self._R
-        k, c = int(self._k[i]), tuple(self._c[i].tolist())
-        ks = vis[c]
-        if len(ks) > 1:  # other angles visited with these contacts: rotations to them
-            rot = np.flatnonzero(row[:nrot])
-            back = np.isin(k + self._rot_delta[rot], np.fromiter(ks, np.int64, len(ks)))
-            row[rot[back]] = False
-        if len(vis) == 1:  # no other grasp visited yet: every regrasp is to a new state
-            return
-        h = int(self._h[i])
-        for a in (np.flatnonzero(row[nrot:]) + nrot).tolist():
-            q = a - nrot
-            lifted = int(self._regrasp_lifted[2 * h + (q & 1)])
-            c2 = list(c)
-            c2[h] = int((self._ws_start[h] + (q >> 1) - k) % self._n)
-            c2[lifted] = -1
-            if k in vis.get(tuple(c2), ()):
-                row[a] = False
+        if self._visited is not None:  # the single env's rule, row by row
+            model = self.model
+            for i, vis in enumerate(self._visited):
+                drop_revisits(model, mask[i], int(self._k[i]), tuple(self._c[i].tolist()),
+                              *vis)
 
     def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
         """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
@@ -628,8 +612,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             self._regrasps += rg
         if self._visited is not None:  # forbid_revisit: the states moved to
             for i in legal.nonzero()[0].tolist():
-                self._visited[i].setdefault(tuple(self._c[i].tolist()), set()).add(
-                    int(self._k[i]))
+                visit_state(self._visited[i], int(self._k[i]), tuple(self._c[i].tolist()))
         # sub-envs whose last episode ended restart here (next-step autoreset)
         if reset_idx.size:
             self._autoreset_subs(reset_idx, infos)
