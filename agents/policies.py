@@ -31,6 +31,14 @@ and turn to go), computed exactly rather than learned: measured on the ellipse
 grasp whose rotation already reaches the turn spent two regrasps there (away from the
 goal and back) in nearly every episode, most of their regrasps beyond the optimum.
 
+The **shortfall code** (``shortfall_bins`` given, with the finishing rotations): the
+turn still to go after the longest legal rotation towards the goal (grid steps, 0 when
+it reaches the turn; the mask and the turn to go of the observation), as a thermometer
+code of ``shortfall_bins`` entries (entry ``j`` is 1 when the shortfall exceeds ``j``
+bin widths of ``abs(turn_steps) / shortfall_bins`` grid steps), so that a linear layer
+reads any step function of it: the regrasps still needed rise in steps of the turn one
+regrasp buys (about 45° on the circle), and a policy that reads the shortfall as one
+number must learn that staircase itself.
 Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
 through unchanged too. The features are the concatenation (header and mask, window
 features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
@@ -105,6 +113,9 @@ class GraspMapExtractor(BaseFeaturesExtractor):
     conv
         Convolutions over the window and the lines (default); False: both pass through
         flat.
+    shortfall_bins
+        With ``turn_steps`` and ``rotations``: the shortfall code's bins (0: none; at
+        most ``abs(turn_steps)``).
     turn_steps
         The requested turn in grid steps, signed (``turn_deg / (360 / n)``: 180 for the
         default 360° at ``n = 180``); with ``rotations``, adds the finishing rotations.
@@ -123,6 +134,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: gym.spaces.Box, cells: int = 36, line_cells: int = 0,
                  tail: int = 0, conv: bool = True, turn_steps: int = 0, rotations: int = 0,
+                 shortfall_bins: int = 0,
                  window_channels: Sequence[int] = (8, 16),
                  line_channels: Sequence[int] = (8, 16),
                  window_features: int = 64, line_features: int = 64) -> None:
@@ -140,8 +152,19 @@ class GraspMapExtractor(BaseFeaturesExtractor):
             width = n_flat + window_features + (line_features if with_lines else 0)
         else:
             width = layout.size
+        if shortfall_bins and not finishing:
+            raise GraspGaitInputError(
+                f"features_extractor_kwargs shortfall_bins={shortfall_bins}: needs "
+                "turn_steps and rotations (the shortfall is the turn to go less the longest "
+                "legal rotation), e.g. turn_steps: 180, rotations: 45")
+        if not 0 <= int(shortfall_bins) <= abs(int(turn_steps or 0)):
+            raise GraspGaitInputError(
+                f"features_extractor_kwargs shortfall_bins={shortfall_bins}: must be 0 (none) "
+                f"up to abs(turn_steps)={abs(int(turn_steps or 0))}, e.g. 90")
+        self.shortfall_bins = int(shortfall_bins)
         super().__init__(observation_space,
-                         width + int(tail) + (int(rotations) if finishing else 0))
+                         width + int(tail) + (int(rotations) if finishing else 0)
+                         + self.shortfall_bins)
         self.layout, self.n_flat, self.tail, self.conv = layout, n_flat, int(tail), bool(conv)
         self.cells, self.line_cells = int(cells), int(line_cells)
         self.turn_steps, self.rotations = int(turn_steps), int(rotations) if finishing else 0
@@ -153,6 +176,11 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                          if conv and with_lines else None)
         # rotation a (0-based) moves a + 1 grid steps towards the goal
         self.register_buffer("_steps", torch.arange(1, self.rotations + 1, dtype=torch.float32),
+                             persistent=False)
+        # shortfall code thresholds: bin j is 1 when the shortfall exceeds j * width
+        width_bins = abs(self.turn_steps) / max(self.shortfall_bins, 1)
+        self.register_buffer("_thresholds", torch.arange(self.shortfall_bins,
+                                                         dtype=torch.float32) * width_bins,
                              persistent=False)
 
     @staticmethod
@@ -178,6 +206,18 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         need = torch.round(observations[:, lay.to_go:lay.to_go + 1] * abs(self.turn_steps))
         return legal * (self._steps >= need).to(legal.dtype)
 
+    def shortfall_code(self, observations: torch.Tensor) -> torch.Tensor:
+        """``(batch, shortfall_bins)``: the turn still to go after the longest legal
+        rotation towards the goal (grid steps, 0 when that rotation reaches the turn), as a
+        thermometer code: bin ``j`` is 1 when it exceeds ``j * abs(turn_steps) /
+        shortfall_bins`` (see the module docstring)."""
+        lay, R = self.layout, self.rotations
+        first = lay.mask.start + (0 if self.turn_steps > 0 else R)
+        reach = (observations[:, first:first + R] * self._steps).amax(dim=1, keepdim=True)
+        need = torch.round(observations[:, lay.to_go:lay.to_go + 1] * abs(self.turn_steps))
+        short = torch.clamp(need - reach, min=0.0)
+        return (short > self._thresholds).to(observations.dtype)
+
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         """Features of a batch of observations, shape ``(batch, features_dim)``."""
         lay, b = self.layout, observations.shape[0]
@@ -194,4 +234,6 @@ class GraspMapExtractor(BaseFeaturesExtractor):
             parts.append(observations[:, lay.size:lay.size + self.tail])
         if self.rotations:
             parts.append(self.finishing_rotations(observations))
+        if self.shortfall_bins:
+            parts.append(self.shortfall_code(observations))
         return torch.cat(parts, dim=1)

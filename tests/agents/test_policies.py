@@ -125,3 +125,39 @@ def test_finishing_rotations_need_a_fitting_rotation_count():
     env = _env()
     with pytest.raises(GraspGaitInputError, match="rotations=500"):
         GraspMapExtractor(env.observation_space, turn_steps=180, rotations=500)
+
+
+def test_shortfall_code_is_the_turn_left_after_the_longest_legal_rotation():
+    env = _env(turn_deg=120.0)
+    m = env.unwrapped.model
+    K, R, bins = m.turn_steps(120.0), int(m.R), 30
+    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
+                            rotations=R, shortfall_bins=bins)
+    assert ext.features_dim == env.observation_space.shape[0] + R + bins
+    rng = np.random.default_rng(2)
+    obs, info = env.reset(seed=0)
+    levels = set()
+    for _ in range(200):
+        mask = info["action_mask"]
+        ccw = np.flatnonzero(mask[:R])
+        reach = int(ccw[-1]) + 1 if ccw.size else 0
+        short = max(0, K - env.unwrapped.state.k - reach)
+        want = (short > np.arange(bins) * (K / bins)).astype(np.float32)
+        code = ext(torch.as_tensor(obs[None]))[0, -bins:].numpy()
+        assert np.array_equal(code, want), (short, code)
+        levels.add(int(code.sum()))
+        a = int(ccw[-1]) if ccw.size and rng.random() < 0.5 else int(
+            rng.choice(np.flatnonzero(mask)))
+        obs, _, term, trunc, info = env.step(np.int64(a))
+        if term or trunc:
+            obs, info = env.reset()
+    assert len(levels) >= 5  # the walk met many shortfalls
+
+
+def test_shortfall_code_needs_the_finishing_rotations():
+    env = _env()
+    with pytest.raises(GraspGaitInputError, match="shortfall_bins=10: needs turn_steps"):
+        GraspMapExtractor(env.observation_space, shortfall_bins=10)
+    with pytest.raises(GraspGaitInputError, match="shortfall_bins=500"):
+        GraspMapExtractor(env.observation_space, turn_steps=180, rotations=45,
+                          shortfall_bins=500)
