@@ -39,6 +39,17 @@ bin widths of ``abs(turn_steps) / shortfall_bins`` grid steps), so that a linear
 reads any step function of it: the regrasps still needed rise in steps of the turn one
 regrasp buys (about 45° on the circle), and a policy that reads the shortfall as one
 number must learn that staircase itself.
+The **forward-gait features** (``workspace_widths`` given, with the finishing
+rotations): the two choices of thesis 6.3.1's forward (staircase) gait, as inputs per
+action, computed from the observation (the held fingers, their workspace positions and
+the mask): a one-hot of the longest legal rotation towards the goal (over its ``R``
+rotations), and for each regrasp action the room for a rotation towards the goal that
+the grasp it makes would have (the rotation room of thesis 5.2, ``min(W - 1 - p)`` over
+the new pair counter-clockwise, ``min(p)`` clockwise; over ``R``; 0 where illegal).
+With a linear policy head on them (``net_arch: {pi: [], vf: [...]}``) a logit can be a
+weight times one of these entries, which a hidden layer narrower than the action space
+cannot pass through for every action; the weights are learned, nothing forces the
+forward gait.
 Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
 through unchanged too. The features are the concatenation (header and mask, window
 features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
@@ -116,6 +127,10 @@ class GraspMapExtractor(BaseFeaturesExtractor):
     shortfall_bins
         With ``turn_steps`` and ``rotations``: the shortfall code's bins (0: none; at
         most ``abs(turn_steps)``).
+    workspace_widths
+        With ``turn_steps`` and ``rotations``: the three fingers' workspace widths in
+        grid points (``GaitModel``'s, ``[46, 46, 46]`` for the thesis hand at ``n =
+        180``); adds the forward-gait features. None (default): none.
     turn_steps
         The requested turn in grid steps, signed (``turn_deg / (360 / n)``: 180 for the
         default 360° at ``n = 180``); with ``rotations``, adds the finishing rotations.
@@ -134,7 +149,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: gym.spaces.Box, cells: int = 36, line_cells: int = 0,
                  tail: int = 0, conv: bool = True, turn_steps: int = 0, rotations: int = 0,
-                 shortfall_bins: int = 0,
+                 shortfall_bins: int = 0, workspace_widths: Sequence[int] | None = None,
                  window_channels: Sequence[int] = (8, 16),
                  line_channels: Sequence[int] = (8, 16),
                  window_features: int = 64, line_features: int = 64) -> None:
@@ -162,9 +177,27 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                 f"features_extractor_kwargs shortfall_bins={shortfall_bins}: must be 0 (none) "
                 f"up to abs(turn_steps)={abs(int(turn_steps or 0))}, e.g. 90")
         self.shortfall_bins = int(shortfall_bins)
+        widths = None if workspace_widths is None else [int(w) for w in workspace_widths]
+        n_forward = 0
+        if widths is not None:
+            n_regrasp = n_actions - 2 * int(rotations)
+            if not finishing or len(widths) != 3 or min(widths) < 1 or 2 * max(widths) != n_regrasp:
+                raise GraspGaitInputError(
+                    f"features_extractor_kwargs workspace_widths={workspace_widths!r}: give "
+                    "the three fingers' workspace widths in grid points (the gait model's, "
+                    f"2 x the widest = the {n_regrasp} regrasp actions), with turn_steps and "
+                    "rotations, e.g. [46, 46, 46] for the thesis hand at n = 180")
+            n_forward = int(rotations) + n_regrasp
         super().__init__(observation_space,
                          width + int(tail) + (int(rotations) if finishing else 0)
-                         + self.shortfall_bins)
+                         + self.shortfall_bins + n_forward)
+        self.gait_features = widths is not None
+        if widths is not None:
+            w_max = max(widths)
+            self.register_buffer("_widths", torch.tensor(widths, dtype=torch.float32),
+                                 persistent=False)
+            self.register_buffer("_positions", torch.arange(w_max, dtype=torch.float32),
+                                 persistent=False)
         self.layout, self.n_flat, self.tail, self.conv = layout, n_flat, int(tail), bool(conv)
         self.cells, self.line_cells = int(cells), int(line_cells)
         self.turn_steps, self.rotations = int(turn_steps), int(rotations) if finishing else 0
@@ -218,6 +251,36 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         short = torch.clamp(need - reach, min=0.0)
         return (short > self._thresholds).to(observations.dtype)
 
+    def forward_gait_features(self, observations: torch.Tensor) -> torch.Tensor:
+        """``(batch, R + 2 W)``: the longest legal rotation towards the goal (one-hot over
+        the ``R`` rotations that way), then for each regrasp action ``2p + l`` the room
+        the grasp it makes leaves for a rotation towards the goal, over ``R`` (0 where the
+        regrasp is illegal); see the module docstring."""
+        lay, R = self.layout, self.rotations
+        first = lay.mask.start + (0 if self.turn_steps > 0 else R)
+        legal_rot = observations[:, first:first + R]
+        reach = (legal_rot * self._steps).amax(dim=1, keepdim=True)
+        longest = legal_rot * (self._steps == reach).to(legal_rot.dtype)
+        held = observations[:, 0:3]
+        wd = self._widths
+        p = torch.round(observations[:, 3:6] * (wd - 1))  # workspace positions (free: < 0)
+        h = torch.argmin(held, dim=1, keepdim=True)  # the free finger
+        f = (h == 0).long()  # the held fingers f < g
+        g = torch.where(h == 2, 1, 2)
+        w_h, w_f, w_g = wd[h], wd[f], wd[g]
+        p_f, p_g = p.gather(1, f), p.gather(1, g)
+        q = self._positions[None, :]  # the free finger's new position
+        if self.turn_steps > 0:  # counter-clockwise room: min(W - 1 - p) over the pair
+            keep_g = torch.minimum(w_h - 1 - q, w_g - 1 - p_g)
+            keep_f = torch.minimum(w_h - 1 - q, w_f - 1 - p_f)
+        else:  # clockwise room: min(p) over the pair
+            qb = q.expand(p.shape[0], -1)
+            keep_g, keep_f = torch.minimum(qb, p_g), torch.minimum(qb, p_f)
+        room = torch.stack((keep_g, keep_f), dim=2).reshape(p.shape[0], -1)  # 2p + l
+        start = lay.mask.start + 2 * R
+        legal_reg = observations[:, start:start + room.shape[1]]
+        return torch.cat((longest, legal_reg * torch.clamp(room, min=0.0) / R), dim=1)
+
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         """Features of a batch of observations, shape ``(batch, features_dim)``."""
         lay, b = self.layout, observations.shape[0]
@@ -236,4 +299,6 @@ class GraspMapExtractor(BaseFeaturesExtractor):
             parts.append(self.finishing_rotations(observations))
         if self.shortfall_bins:
             parts.append(self.shortfall_code(observations))
+        if self.gait_features:
+            parts.append(self.forward_gait_features(observations))
         return torch.cat(parts, dim=1)

@@ -161,3 +161,52 @@ def test_shortfall_code_needs_the_finishing_rotations():
     with pytest.raises(GraspGaitInputError, match="shortfall_bins=500"):
         GraspMapExtractor(env.observation_space, turn_steps=180, rotations=45,
                           shortfall_bins=500)
+
+
+@pytest.mark.parametrize("turn_deg", [360.0, -360.0])
+def test_forward_gait_features_are_the_longest_rotation_and_the_room_after_each_regrasp(
+        turn_deg):
+    env = _env(turn_deg=turn_deg)
+    u = env.unwrapped
+    m = u.model
+    K, R = m.turn_steps(turn_deg), int(m.R)
+    widths = [int(w) for w in m._widths]
+    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
+                            rotations=R, workspace_widths=widths)
+    n_reg = env.action_space.n - 2 * R
+    assert ext.features_dim == env.observation_space.shape[0] + R + R + n_reg
+    rng = np.random.default_rng(3)
+    obs, info = env.reset(seed=0)
+    rooms = set()
+    for _ in range(150):
+        mask, s = info["action_mask"], u.state
+        way = slice(0, R) if K > 0 else slice(R, 2 * R)
+        legal = np.flatnonzero(mask[way])
+        longest = np.zeros(R, dtype=np.float32)
+        if legal.size:
+            longest[legal[-1]] = 1.0
+        room = np.zeros(n_reg, dtype=np.float32)
+        for a in np.flatnonzero(mask[2 * R:]) + 2 * R:
+            t = m.apply(s, int(a))
+            f, g = t.held()
+            ccw, cw = m.rotation_room(f, int(m.position(f, t.contacts[f], t.k)),
+                                      g, int(m.position(g, t.contacts[g], t.k)))
+            room[a - 2 * R] = (ccw if K > 0 else cw) / R
+        feats = ext(torch.as_tensor(obs[None]))[0, -(R + n_reg):].numpy()
+        np.testing.assert_array_equal(feats[:R], longest)
+        np.testing.assert_allclose(feats[R:], room, atol=1e-6)
+        rooms.update(np.round(room[room > 0] * R).astype(int).tolist())
+        a = int(rng.choice(np.flatnonzero(mask)))
+        obs, _, term, trunc, info = env.step(np.int64(a))
+        if term or trunc:
+            obs, info = env.reset()
+    assert len(rooms) >= 10  # many different rooms met
+
+
+def test_forward_gait_features_need_the_hand_widths():
+    env = _env()
+    with pytest.raises(GraspGaitInputError, match="workspace_widths=\\[46, 46\\]"):
+        GraspMapExtractor(env.observation_space, turn_steps=180, rotations=45,
+                          workspace_widths=[46, 46])
+    with pytest.raises(GraspGaitInputError, match="workspace_widths"):
+        GraspMapExtractor(env.observation_space, workspace_widths=[46, 46, 46])
