@@ -45,7 +45,8 @@ action, computed from the observation (the held fingers, their workspace positio
 the mask): a one-hot of the longest legal rotation towards the goal (over its ``R``
 rotations), and for each regrasp action the room for a rotation towards the goal that
 the grasp it makes would have (the rotation room of thesis 5.2, ``min(W - 1 - p)`` over
-the new pair counter-clockwise, ``min(p)`` clockwise; over ``R``; 0 where illegal).
+the new pair counter-clockwise, ``min(p)`` clockwise; over ``R``; 0 where illegal),
+and, with ``best_regrasp``, a one-hot of the legal regrasps with the most room.
 With a linear policy head on them (``net_arch: {pi: [], vf: [...]}``) a logit can be a
 weight times one of these entries, which a hidden layer narrower than the action space
 cannot pass through for every action; the weights are learned, nothing forces the
@@ -131,6 +132,8 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         With ``turn_steps`` and ``rotations``: the three fingers' workspace widths in
         grid points (``GaitModel``'s, ``[46, 46, 46]`` for the thesis hand at ``n =
         180``); adds the forward-gait features. None (default): none.
+    best_regrasp
+        With ``workspace_widths``: add the one-hot of the regrasps with the most room.
     turn_steps
         The requested turn in grid steps, signed (``turn_deg / (360 / n)``: 180 for the
         default 360° at ``n = 180``); with ``rotations``, adds the finishing rotations.
@@ -150,6 +153,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
     def __init__(self, observation_space: gym.spaces.Box, cells: int = 36, line_cells: int = 0,
                  tail: int = 0, conv: bool = True, turn_steps: int = 0, rotations: int = 0,
                  shortfall_bins: int = 0, workspace_widths: Sequence[int] | None = None,
+                 best_regrasp: bool = False,
                  window_channels: Sequence[int] = (8, 16),
                  line_channels: Sequence[int] = (8, 16),
                  window_features: int = 64, line_features: int = 64) -> None:
@@ -187,11 +191,12 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                     "the three fingers' workspace widths in grid points (the gait model's, "
                     f"2 x the widest = the {n_regrasp} regrasp actions), with turn_steps and "
                     "rotations, e.g. [46, 46, 46] for the thesis hand at n = 180")
-            n_forward = int(rotations) + n_regrasp
+            n_forward = int(rotations) + (2 if best_regrasp else 1) * n_regrasp
         super().__init__(observation_space,
                          width + int(tail) + (int(rotations) if finishing else 0)
                          + self.shortfall_bins + n_forward)
         self.gait_features = widths is not None
+        self.best_regrasp = bool(best_regrasp) and widths is not None
         if widths is not None:
             w_max = max(widths)
             self.register_buffer("_widths", torch.tensor(widths, dtype=torch.float32),
@@ -255,7 +260,9 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         """``(batch, R + 2 W)``: the longest legal rotation towards the goal (one-hot over
         the ``R`` rotations that way), then for each regrasp action ``2p + l`` the room
         the grasp it makes leaves for a rotation towards the goal, over ``R`` (0 where the
-        regrasp is illegal); see the module docstring."""
+        regrasp is illegal); with ``best_regrasp`` ``2 W`` more, a one-hot of the legal
+        regrasps with the most room (all 0 when none leaves any); see the module
+        docstring."""
         lay, R = self.layout, self.rotations
         first = lay.mask.start + (0 if self.turn_steps > 0 else R)
         legal_rot = observations[:, first:first + R]
@@ -279,7 +286,12 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         room = torch.stack((keep_g, keep_f), dim=2).reshape(p.shape[0], -1)  # 2p + l
         start = lay.mask.start + 2 * R
         legal_reg = observations[:, start:start + room.shape[1]]
-        return torch.cat((longest, legal_reg * torch.clamp(room, min=0.0) / R), dim=1)
+        room = legal_reg * torch.clamp(room, min=0.0) / R
+        most = room.amax(dim=1, keepdim=True)
+        best = ((room == most) & (most > 0)).to(room.dtype)
+        if not self.best_regrasp:
+            return torch.cat((longest, room), dim=1)
+        return torch.cat((longest, room, best), dim=1)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         """Features of a batch of observations, shape ``(batch, features_dim)``."""

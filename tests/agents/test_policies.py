@@ -172,9 +172,11 @@ def test_forward_gait_features_are_the_longest_rotation_and_the_room_after_each_
     K, R = m.turn_steps(turn_deg), int(m.R)
     widths = [int(w) for w in m._widths]
     ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
-                            rotations=R, workspace_widths=widths)
+                            rotations=R, workspace_widths=widths, best_regrasp=True)
+    plain = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
+                              rotations=R, workspace_widths=widths)
     n_reg = env.action_space.n - 2 * R
-    assert ext.features_dim == env.observation_space.shape[0] + R + R + n_reg
+    assert ext.features_dim == env.observation_space.shape[0] + R + R + 2 * n_reg
     rng = np.random.default_rng(3)
     obs, info = env.reset(seed=0)
     rooms = set()
@@ -192,9 +194,13 @@ def test_forward_gait_features_are_the_longest_rotation_and_the_room_after_each_
             ccw, cw = m.rotation_room(f, int(m.position(f, t.contacts[f], t.k)),
                                       g, int(m.position(g, t.contacts[g], t.k)))
             room[a - 2 * R] = (ccw if K > 0 else cw) / R
-        feats = ext(torch.as_tensor(obs[None]))[0, -(R + n_reg):].numpy()
+        feats = ext(torch.as_tensor(obs[None]))[0, -(R + 2 * n_reg):].numpy()
         np.testing.assert_array_equal(feats[:R], longest)
-        np.testing.assert_allclose(feats[R:], room, atol=1e-6)
+        np.testing.assert_allclose(feats[R:R + n_reg], room, atol=1e-6)
+        best = (room == room.max()) & (room.max() > 0)
+        np.testing.assert_array_equal(feats[R + n_reg:], best.astype(np.float32))
+        np.testing.assert_array_equal(plain(torch.as_tensor(obs[None]))[0].numpy(),
+                                      ext(torch.as_tensor(obs[None]))[0, :-n_reg].numpy())
         rooms.update(np.round(room[room > 0] * R).astype(int).tolist())
         a = int(rng.choice(np.flatnonzero(mask)))
         obs, _, term, trunc, info = env.step(np.int64(a))
