@@ -6,7 +6,6 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import ROTATE, GaitModel
 from graspgait_env.planners.exact import RegraspsToGo
 
@@ -105,13 +104,6 @@ def test_the_fewest_regrasps_are_unchanged(obj):
         assert (-1 if free is None else free) == to_go(s0)
         checked += free is not None
     assert checked >= 3
-
-
-def test_off_by_default_and_checked():
-    env = gym.make("graspgait_env:GraspGait-v0")
-    assert env.unwrapped.config.forbid_reversal is False
-    with pytest.raises(GraspGaitInputError, match="forbid_reversal='no': must be True or False"):
-        gym.make("graspgait_env:GraspGait-v0", forbid_reversal="no")
 
 
 def test_mujoco_env_forbids_reversal_on_the_commanded_state():

@@ -119,24 +119,25 @@ def test_a_regrasp_and_its_undo():
     np.testing.assert_array_equal(info["action_mask"], u.model.action_mask(u.state))
 
 
-def test_off_by_default_and_checked():
+@pytest.mark.parametrize("field", ["forbid_reversal", "forbid_revisit"])
+def test_move_rules_off_by_default_and_checked(field):
     env = gym.make("graspgait_env:GraspGait-v0")
-    assert env.unwrapped.config.forbid_revisit is False
-    with pytest.raises(GraspGaitInputError, match="forbid_revisit='no': must be True or False"):
-        gym.make("graspgait_env:GraspGait-v0", forbid_revisit="no")
+    assert getattr(env.unwrapped.config, field) is False
+    with pytest.raises(GraspGaitInputError, match=f"{field}='no': must be True or False"):
+        gym.make("graspgait_env:GraspGait-v0", **{field: "no"})
 
 
-def test_mujoco_env_forbids_revisits_of_the_commanded_state():
+def test_mujoco_env_forbids_undoing_a_regrasp_on_the_commanded_state():
     env = gym.make("graspgait_env.envs:GraspGaitMujoco-v1", object="ellipse",
                    forbid_revisit=True)
     u = env.unwrapped
-    R = u.model.R
     obs, info = env.reset(seed=0)
-    s0 = u.state
-    rot = np.flatnonzero(info["action_mask"][:R])
-    obs, _, term, trunc, info = env.step(int(rot[0]))
-    assert not (term or trunc)
-    assert not info["action_mask"][u.model.encode(u.state, s0)]
+    before = u.state
+    regrasps = np.flatnonzero(info["action_mask"][2 * u.model.R:]) + 2 * u.model.R
+    obs, _, term, trunc, info = env.step(int(regrasps[0]))
+    assert not (term or trunc) and u.state.held() != before.held()
+    undo = u.model.encode(u.state, before)
+    assert u.model.action_mask(u.state)[undo] and not info["action_mask"][undo]
 
 
 def test_gait_model_unchanged():
