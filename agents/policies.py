@@ -238,22 +238,28 @@ class GraspMapExtractor(BaseFeaturesExtractor):
     def finishing_rotations(self, observations: torch.Tensor) -> torch.Tensor:
         """``(batch, R)``: 1 where the rotation towards the goal by ``a + 1`` grid steps is
         legal and reaches the requested turn, else 0 (see the module docstring)."""
-        lay, R = self.layout, self.rotations
-        first = lay.mask.start + (0 if self.turn_steps > 0 else R)  # CCW: 0..R-1, CW: R..2R-1
-        legal = observations[:, first:first + R]
-        need = torch.round(observations[:, lay.to_go:lay.to_go + 1] * abs(self.turn_steps))
+        legal, need = self._goal_rotations(observations), self._steps_to_go(observations)
         return legal * (self._steps >= need).to(legal.dtype)
+
+    def _goal_rotations(self, observations: torch.Tensor) -> torch.Tensor:
+        """``(batch, R)``: the mask's rotations towards the goal (CCW: actions 0..R-1, CW:
+        R..2R-1), rotation ``a`` by ``a + 1`` grid steps."""
+        R = self.rotations
+        first = self.layout.mask.start + (0 if self.turn_steps > 0 else R)
+        return observations[:, first:first + R]
+
+    def _steps_to_go(self, observations: torch.Tensor) -> torch.Tensor:
+        """``(batch, 1)``: the turn still to go, in grid steps (header entry 15)."""
+        lay = self.layout
+        return torch.round(observations[:, lay.to_go:lay.to_go + 1] * abs(self.turn_steps))
 
     def shortfall_code(self, observations: torch.Tensor) -> torch.Tensor:
         """``(batch, shortfall_bins)``: the turn still to go after the longest legal
         rotation towards the goal (grid steps, 0 when that rotation reaches the turn), as a
         thermometer code: bin ``j`` is 1 when it exceeds ``j * abs(turn_steps) /
         shortfall_bins`` (see the module docstring)."""
-        lay, R = self.layout, self.rotations
-        first = lay.mask.start + (0 if self.turn_steps > 0 else R)
-        reach = (observations[:, first:first + R] * self._steps).amax(dim=1, keepdim=True)
-        need = torch.round(observations[:, lay.to_go:lay.to_go + 1] * abs(self.turn_steps))
-        short = torch.clamp(need - reach, min=0.0)
+        reach = (self._goal_rotations(observations) * self._steps).amax(dim=1, keepdim=True)
+        short = torch.clamp(self._steps_to_go(observations) - reach, min=0.0)
         return (short > self._thresholds).to(observations.dtype)
 
     def forward_gait_features(self, observations: torch.Tensor) -> torch.Tensor:
@@ -264,8 +270,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         regrasps with the most room (all 0 when none leaves any); see the module
         docstring."""
         lay, R = self.layout, self.rotations
-        first = lay.mask.start + (0 if self.turn_steps > 0 else R)
-        legal_rot = observations[:, first:first + R]
+        legal_rot = self._goal_rotations(observations)
         reach = (legal_rot * self._steps).amax(dim=1, keepdim=True)
         longest = legal_rot * (self._steps == reach).to(legal_rot.dtype)
         held = observations[:, 0:3]
@@ -287,10 +292,10 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         start = lay.mask.start + 2 * R
         legal_reg = observations[:, start:start + room.shape[1]]
         room = legal_reg * torch.clamp(room, min=0.0) / R
-        most = room.amax(dim=1, keepdim=True)
-        best = ((room == most) & (most > 0)).to(room.dtype)
         if not self.best_regrasp:
             return torch.cat((longest, room), dim=1)
+        most = room.amax(dim=1, keepdim=True)
+        best = ((room == most) & (most > 0)).to(room.dtype)
         return torch.cat((longest, room, best), dim=1)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:

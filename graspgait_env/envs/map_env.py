@@ -166,25 +166,18 @@ def drop_revisits(model: GaitModel, mask: NDArray[np.bool_], k: int,
 
     A rotation keeps the contacts and a regrasp the angle, so only the angles visited
     with these contacts and the grasps visited at this angle are looked at, each
-    mapped to the one action that reaches it (:meth:`GaitModel.encode`); the cost grows
-    with those visits, not with the legal moves.
+    mapped to the one action that reaches it (:meth:`GaitModel.encode`, checked with
+    :meth:`GaitModel.apply`); the cost grows with those visits, not with the legal moves.
     """
     s = GaitState(k, contacts)
-    R = model.R
-    for k2 in by_contacts.get(contacts, ()):
-        d = k2 - k
-        if 0 < d <= R:
-            mask[d - 1] = False
-        elif 0 < -d <= R:
-            mask[R - d - 1] = False
-    for c2 in by_angle.get(k, ()):
-        if c2 == contacts:
-            continue
+    near = [GaitState(k2, contacts) for k2 in by_contacts.get(contacts, ()) if k2 != k]
+    near += [GaitState(k, c2) for c2 in by_angle.get(k, ()) if c2 != contacts]
+    for t in near:
         try:
-            a = model.encode(s, GaitState(k, c2))
-        except ValueError:  # no one regrasp reaches that grasp
+            a = model.encode(s, t)
+        except ValueError:  # no one move reaches it
             continue
-        if mask[a] and model.apply(s, a).contacts == c2:  # encode reads the new contact only
+        if mask[a] and model.apply(s, a) == t:  # encode reads the moved contact only
             mask[a] = False
 
 

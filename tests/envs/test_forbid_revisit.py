@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from graspgait_env.errors import GraspGaitInputError
-from graspgait_env.gait import GaitModel
 from graspgait_env.planners.exact import RegraspsToGo
 from graspgait_env.planners.registry import run_planner
 from tests.planners.helpers import replay
@@ -138,11 +137,3 @@ def test_mujoco_env_forbids_undoing_a_regrasp_on_the_commanded_state():
     assert not (term or trunc) and u.state.held() != before.held()
     undo = u.model.encode(u.state, before)
     assert u.model.action_mask(u.state)[undo] and not info["action_mask"][undo]
-
-
-def test_gait_model_unchanged():
-    """The rule lives in the env: the gait model's legal moves are untouched."""
-    model = GaitModel("ellipse", 0.7)
-    env = gym.make("graspgait_env:GraspGait-v0", object="ellipse", forbid_revisit=True)
-    obs, info = env.reset(seed=1)
-    np.testing.assert_array_equal(info["action_mask"], model.action_mask(env.unwrapped.state))
