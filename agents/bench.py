@@ -32,7 +32,6 @@ both succeeded). :func:`plot_bench` draws regrasps per 360° of every method.
 
 from __future__ import annotations
 
-import importlib.resources
 import math
 import os
 import statistics
@@ -43,7 +42,7 @@ from typing import Any
 
 from tqdm.auto import tqdm
 
-from agents.card import load_agent
+from agents.card import load_agent, shipped_models_dir
 from agents.envs import env_kwargs_for, make_env
 from agents.evaluate import agent_predictor, play_episode
 from baselines.bench import THESIS_OBJECTS, BenchCase, bench_starts
@@ -76,11 +75,6 @@ class Agent:
         """Whether the bench runs this agent on object ``obj`` (see the module docstring)."""
         trained = (self.card.get("env_kwargs") or {}).get("object")
         return self.generalist or trained is None or str(trained) == obj
-
-
-def shipped_models_dir() -> Path:
-    """``agents/models/`` (package data of :mod:`agents`)."""
-    return Path(str(importlib.resources.files("agents") / "models"))
 
 
 def find_agents(spec: str = "shipped") -> tuple[list[Agent], list[str]]:

@@ -9,6 +9,8 @@ Every model ``graspgait train`` writes (final model, best model, checkpoints) is
   ``"point"`` before contact models existed);
 - ``config`` (every :class:`~agents.config.TrainConfig` field), ``seed``, ``steps``
   (environment steps trained), ``wall_s`` (training wall time, seconds), ``run_dir``;
+- ``init`` (a run started from ``init_model`` only): ``{model, steps, wall_s}``, the
+  training behind the weights it started from;
 - ``eval``: the latest periodic evaluation (success rates, regrasps against the
   optimum), when there was one;
 - ``versions``: graspgait_env, stable-baselines3, sb3-contrib, torch, gymnasium, Python;
@@ -21,6 +23,7 @@ RL Zoo gets a card made from RL Zoo's saved hyper-parameters (env id, env keywor
 
 from __future__ import annotations
 
+import importlib.resources
 import json
 import os
 import platform
@@ -35,9 +38,26 @@ import yaml
 from graspgait_env.atomic import atomic_write, write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["CARD_FORMAT", "card_path", "load_agent", "read_card", "save_agent", "versions"]
+__all__ = ["CARD_FORMAT", "card_path", "load_agent", "read_card", "resolve_model",
+           "save_agent", "shipped_models_dir", "versions"]
 
 CARD_FORMAT = "graspgait-model-card/1"
+
+
+def shipped_models_dir() -> Path:
+    """``agents/models/`` (package data of :mod:`agents`: the shipped models)."""
+    return Path(str(importlib.resources.files("agents") / "models"))
+
+
+def resolve_model(spec: str | os.PathLike[str]) -> Path:
+    """A model's path: ``spec`` as a path, or a shipped model's name (``hexagon`` ->
+    ``agents/models/hexagon.zip`` of the installed package) when no such file exists."""
+    path = Path(spec)
+    if not path.is_file() and path.suffix != ".zip" and len(path.parts) == 1:
+        shipped = shipped_models_dir() / f"{path.name}.zip"
+        if shipped.is_file():
+            return shipped
+    return path
 
 
 def card_path(model_path: str | os.PathLike[str]) -> Path:

@@ -149,6 +149,11 @@ class TrainConfig:
     wrappers: list[str] = field(default_factory=list)
     """Gymnasium wrappers applied to every env, innermost first, as import paths
     (``"agents.wrappers:LegalActionWrapper"``)."""
+    train_wrappers: list[str] = field(default_factory=list)
+    """Gymnasium wrappers of the training envs only, outside ``wrappers``, as import paths
+    (``"agents.wrappers:RuleBasedStartWrapper"``, a start distribution): the periodic
+    evaluation and ``graspgait evaluate`` run without them, and the card's ``wrappers``
+    leaves them out."""
     policy: str = "MlpPolicy"
     """SB3 policy name (``MlpPolicy``)."""
     net_arch: list[int] | dict[str, list[int]] = field(default_factory=lambda: [64, 64])
@@ -208,6 +213,14 @@ class TrainConfig:
     """Torch device (``cpu``; small MLPs gain nothing from a GPU)."""
     run_root: str = "runs"
     """Folder under which each run gets its own folder."""
+    init_model: str | None = None
+    """A saved model (a ``.zip`` path, or a shipped model's name: ``hexagon_explore`` is
+    ``agents/models/hexagon_explore.zip``) whose policy and value weights start this run,
+    or None (a fresh network). Only the weights carry over: the optimizer, the step count and the
+    learning-rate schedule start afresh, so a run can continue another under a new reward
+    (a curriculum, a fine-tune). The model must have this config's algorithm, observation
+    and action spaces and network. The card records its steps and wall time
+    (``init``), so the training a model took is stated in full."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -228,6 +241,12 @@ class TrainConfig:
                                       "paths, e.g. ['agents.wrappers:LegalActionWrapper']")
         put("wrappers", [_check_import_path(f"wrappers[{i}]", w)
                          for i, w in enumerate(self.wrappers)])
+        if isinstance(self.train_wrappers, str) or not isinstance(self.train_wrappers, Sequence):
+            raise GraspGaitInputError(
+                f"train_wrappers={self.train_wrappers!r}: must be a list of import paths, "
+                "e.g. ['agents.wrappers:RuleBasedStartWrapper']")
+        put("train_wrappers", [_check_import_path(f"train_wrappers[{i}]", w)
+                               for i, w in enumerate(self.train_wrappers)])
         put("policy", _check_str("policy", self.policy, ("MlpPolicy",)))
         put("net_arch", _check_net_arch(self.net_arch))
         put("activation", _check_str("activation", self.activation, ACTIVATIONS))
@@ -282,6 +301,12 @@ class TrainConfig:
             raise GraspGaitInputError(f"run_root={self.run_root!r}: must be a folder path, "
                                       "e.g. 'runs'")
         put("run_root", str(self.run_root))
+        if self.init_model is not None:
+            if not isinstance(self.init_model, (str, os.PathLike)) or not str(self.init_model):
+                raise GraspGaitInputError(f"init_model={self.init_model!r}: must be a saved "
+                                          "model's path or a shipped model's name, e.g. "
+                                          "hexagon_explore")
+            put("init_model", str(self.init_model))
 
     @classmethod
     def field_names(cls) -> tuple[str, ...]:

@@ -103,6 +103,11 @@ class ReferenceGaits:
         g = table(start)
         return None if g < 0 else int(g)
 
+    def model_key(self, model: GaitModel) -> tuple:
+        """A hashable key of what the planners read of ``model`` (its grasp map's
+        digest, grid and hand workspaces)."""
+        return self._model_key(model)
+
     def _model_key(self, model: GaitModel) -> tuple:
         held = self._digests.get(id(model))
         if held is None or held[0] is not model:

@@ -14,6 +14,10 @@ A run lives in its own folder, ``{run_root}/{env_id}-{config name}-s{seed}-{YYYY
   optimum; with ``best_success_floor``, fewest regrasps among those reaching it);
 - ``model.zip`` + ``model.json``: the final model and its card (:mod:`agents.card`).
 
+With ``init_model`` the run starts from the weights of a saved model (a curriculum: the
+same network trained on under a new reward); its card's ``init`` says how many steps and
+how much wall time lay behind those weights.
+
 The periodic evaluation (every ``eval_freq`` steps and at the end) plays
 ``eval_episodes`` episodes from fixed starts (reset seeds 10000, 10001, ...) in a
 separate env made like the training ones, greedy actions, and compares the agent with
@@ -36,7 +40,7 @@ from typing import Any
 import yaml
 from tqdm.auto import tqdm
 
-from agents.card import read_card, save_agent
+from agents.card import read_card, resolve_model, save_agent
 from agents.config import TrainConfig
 from agents.envs import contact_model_of, import_object, make_env
 from agents.evaluate import (
@@ -55,7 +59,7 @@ from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["TrainResult", "train", "run_name", "build_model", "make_vec_env_for",
-           "selection_score"]
+           "selection_score", "init_from_model"]
 
 
 @dataclass(frozen=True)
@@ -135,11 +139,13 @@ def _new_run_dir(config: TrainConfig) -> Path:
 
 
 def make_vec_env_for(config: TrainConfig, n_envs: int | None = None) -> Any:
-    """The SB3 vector env of ``config`` (``n_envs`` envs, env ``i`` seeded ``seed + i``)."""
+    """The SB3 vector env of ``config`` (``n_envs`` envs, env ``i`` seeded ``seed + i``),
+    with ``wrappers`` and then ``train_wrappers``."""
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
-    env_id, kwargs, wrappers = config.env_id, dict(config.env_kwargs), tuple(config.wrappers)
+    env_id, kwargs = config.env_id, dict(config.env_kwargs)
+    wrappers = (*config.wrappers, *config.train_wrappers)  # training envs: both
     make_env(env_id, kwargs, wrappers).close()  # bad keywords fail here, in this process
     if config.vec_env == "batched":
         from agents.vec_env import make_batched_vec_env
@@ -147,7 +153,8 @@ def make_vec_env_for(config: TrainConfig, n_envs: int | None = None) -> Any:
         if env_id != "GraspGait-v0" or wrappers:
             raise GraspGaitInputError(
                 f"vec_env='batched' with env_id={env_id!r}, wrappers={list(wrappers)}: the "
-                "batched env is GraspGait-v0 without wrappers; use vec_env=dummy")
+                "batched env is GraspGait-v0 without wrappers or train_wrappers; use "
+                "vec_env=dummy")
         return make_batched_vec_env(n_envs or config.n_envs, seed=config.seed,
                                     env_kwargs=kwargs)
     cls = SubprocVecEnv if config.vec_env == "subproc" else DummyVecEnv
@@ -292,6 +299,59 @@ def _callbacks(config: TrainConfig, run_dir: Path, card_base: dict[str, Any],
     return Periodic()
 
 
+def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
+    """Copy the policy and value weights of ``config.init_model`` into ``model``.
+
+    Parameters
+    ----------
+    model
+        A fresh model of ``config`` (:func:`build_model`).
+    config
+        Its config; ``config.init_model`` names the saved model to start from.
+
+    Returns
+    -------
+    dict
+        The card's ``init`` record: ``model`` (the path), ``steps`` and ``wall_s`` (the
+        training behind those weights, its own ``init`` included).
+
+    Raises
+    ------
+    GraspGaitInputError
+        No such file, or a model of another algorithm, observation or action space, or
+        network.
+    """
+    path = resolve_model(str(config.init_model))
+    if not path.is_file():
+        raise GraspGaitInputError(f"init_model={str(config.init_model)!r}: no such model; "
+                                  "give a saved model's path or a shipped model's name, "
+                                  "e.g. hexagon_explore")
+    card = read_card(path)
+    if card.get("algo") not in (None, config.algo):
+        raise GraspGaitInputError(f"init_model={str(path)!r}: a {card['algo']} model, the "
+                                  f"config trains {config.algo}; set algo={card['algo']}")
+    source = _algo_class(config.algo).load(path, device=config.device)
+    for what in ("observation_space", "action_space"):
+        mine, theirs = getattr(model, what), getattr(source, what)
+        if mine != theirs:
+            raise GraspGaitInputError(
+                f"init_model={str(path)!r}: its {what} is {theirs}, this config's env gives "
+                f"{mine}; train with the env keywords it was trained with "
+                f"(env_kwargs={card.get('env_kwargs')})")
+    try:
+        model.policy.load_state_dict(source.policy.state_dict())
+    except RuntimeError as exc:
+        first = str(exc).splitlines()[0]
+        raise GraspGaitInputError(
+            f"init_model={str(path)!r}: its network does not fit this config's ({first}); "
+            f"set net_arch={card.get('config', {}).get('net_arch')} and its features "
+            "extractor") from None
+    before = card.get("init") or {}
+    return {"model": str(config.init_model),
+            "steps": int(card.get("steps") or 0) + int(before.get("steps") or 0),
+            "wall_s": float(card.get("wall_s") or 0.0) + float(before.get("wall_s") or 0.0)}
+
+
 def _resume_dir(checkpoint: Path) -> Path:
     """The run folder of a checkpoint (``RUN/checkpoints/x.zip`` -> ``RUN``; else its folder)."""
     parent = checkpoint.resolve().parent
@@ -347,16 +407,24 @@ def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
                 f"--resume {str(resume)!r}: already trained {done} steps, total_timesteps is "
                 f"{config.total_timesteps}; raise it, e.g. --set total_timesteps={2 * done}")
     env = make_vec_env_for(config)
+    init: dict[str, Any] | None = None
+    try:
+        if ckpt is not None:
+            model = _algo_class(config.algo).load(ckpt, env=env, device=config.device)
+            init = read_card(ckpt).get("init")  # the weights it started from, if any
+        else:
+            model = build_model(config, env)
+            if config.init_model is not None:
+                init = init_from_model(model, config)
+    except BaseException:
+        env.close()
+        raise
+    # the run folder only once the model stands: a refused init_model leaves none behind
     run = Path(run_dir) if run_dir is not None else (
         _resume_dir(ckpt) if ckpt is not None else _new_run_dir(config))
     run.mkdir(parents=True, exist_ok=True)
+    model.tensorboard_log = str(run / "tb")  # read by learn()
     write_text_atomic(run / "config.yaml", yaml.safe_dump(config.to_dict(), sort_keys=False))
-    tb = str(run / "tb")
-    if ckpt is not None:
-        model = _algo_class(config.algo).load(ckpt, env=env, device=config.device,
-                                              tensorboard_log=tb)
-    else:
-        model = build_model(config, env, tensorboard_log=tb)
     probe = make_env(config.env_id, config.env_kwargs, config.wrappers)
     contact_model = contact_model_of(probe)
     probe.close()
@@ -364,6 +432,8 @@ def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
                  "env_kwargs": dict(config.env_kwargs), "wrappers": list(config.wrappers),
                  "contact_model": contact_model, "config": config.to_dict(),
                  "seed": config.seed, "run_dir": str(run)}
+    if init is not None:
+        card_base["init"] = init
     t0 = time.perf_counter()
     cb = _callbacks(config, run, card_base, progress, wall_before, t0)
     try:

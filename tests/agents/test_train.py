@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -12,7 +13,7 @@ import torch
 
 from agents.card import load_agent, read_card, save_agent
 from agents.config import load_train_config
-from agents.train import build_model, make_vec_env_for, train
+from agents.train import build_model, init_from_model, make_vec_env_for, train
 from graspgait_env.errors import GraspGaitInputError
 
 
@@ -127,3 +128,78 @@ def test_bad_env_keywords_fail_before_training(tmp_path):
     with pytest.raises(GraspGaitInputError, match=r"mu=-1"):
         train(cfg, progress=False)
     assert not list(tmp_path.iterdir())  # no run folder left behind
+
+
+def test_init_model_starts_from_the_saved_weights_and_states_their_training(tmp_path, smoke_run):
+    src = smoke_run.model_path
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", f"init_model={src}",
+                                      "eval_freq=0", "checkpoint_freq=0"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    fresh = [p.detach().clone() for p in model.policy.parameters()]
+    init = init_from_model(model, cfg)
+    assert init == {"model": str(src), "steps": 256, "wall_s": read_card(src)["wall_s"]}
+    loaded = _params(src)
+    assert all(torch.equal(p, q) for p, q in zip(model.policy.parameters(), loaded, strict=True))
+    assert not all(torch.equal(p, q) for p, q in zip(fresh, loaded, strict=True))
+    res = train(cfg, progress=False)  # trains on from the weights, step count from 0
+    card = read_card(res.model_path)
+    assert card["steps"] == 256 and card["init"]["steps"] == 256
+    assert card["config"]["init_model"] == str(src)
+    # a second stage counts the whole chain behind it
+    again = load_train_config("smoke", [f"run_root={tmp_path}", f"init_model={res.model_path}",
+                                        "eval_freq=0", "checkpoint_freq=0"])
+    chain = init_from_model(build_model(again, make_vec_env_for(again)), again)
+    assert chain["steps"] == 512
+    assert chain["wall_s"] == pytest.approx(card["wall_s"] + card["init"]["wall_s"])
+
+
+def test_init_model_takes_a_shipped_models_name():
+    from agents.card import resolve_model, shipped_models_dir
+
+    assert resolve_model("ellipse") == shipped_models_dir() / "ellipse.zip"
+    assert resolve_model("nope") == Path("nope")  # not shipped: the path, refused later
+    cfg = load_train_config("ellipse", ["init_model=ellipse"])
+    model = build_model(cfg, make_vec_env_for(cfg, n_envs=1))
+    init = init_from_model(model, cfg)
+    card = read_card(shipped_models_dir() / "ellipse.zip")
+    assert init == {"model": "ellipse", "steps": card["steps"], "wall_s": card["wall_s"]}
+    assert all(torch.equal(p, q) for p, q in zip(
+        model.policy.parameters(), _params(shipped_models_dir() / "ellipse.zip"), strict=True))
+
+
+def test_init_model_refuses_a_model_that_does_not_fit(tmp_path, smoke_run):
+    src = str(smoke_run.model_path)
+    for overrides, message in (
+            (["init_model=nope.zip"], r"init_model='nope.zip': no such model"),
+            (["net_arch=[8]"], r"its network does not fit .*set net_arch=\[16\]"),
+            (["env_kwargs.map_lines=true"], r"its observation_space is .*env_kwargs="),
+            (["algo=ppo", "wrappers=[agents.wrappers.LegalActionWrapper]"],
+             r"a maskable_ppo model, the config trains ppo")):
+        cfg = load_train_config("smoke", [f"run_root={tmp_path / 'r'}", f"init_model={src}",
+                                          *overrides])
+        with pytest.raises(GraspGaitInputError, match=message):
+            train(cfg, progress=False)
+    assert not (tmp_path / "r").exists()  # no run folder left behind
+
+
+def test_train_wrappers_wrap_the_training_envs_only(tmp_path):
+    from agents.wrappers import SolvableStartWrapper
+
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", "eval_freq=0",
+                                      "checkpoint_freq=0",
+                                      "train_wrappers=[agents.wrappers.SolvableStartWrapper]"])
+    venv = make_vec_env_for(cfg)
+    for env in venv.envs:
+        while not isinstance(env, SolvableStartWrapper):
+            assert isinstance(env, gym.Wrapper), "SolvableStartWrapper missing"
+            env = env.env
+    venv.close()
+    res = train(cfg, progress=False)
+    card = read_card(res.model_path)
+    assert card["wrappers"] == []  # what evaluate runs the model in
+    assert card["config"]["train_wrappers"] == ["agents.wrappers.SolvableStartWrapper"]
+    with pytest.raises(GraspGaitInputError, match=r"train_wrappers='x': must be a list"):
+        load_train_config("smoke", ["train_wrappers=x"])
+    with pytest.raises(GraspGaitInputError, match=r"vec_env='batched'.*train_wrappers"):
+        make_vec_env_for(load_train_config("smoke", [
+            "vec_env=batched", "train_wrappers=[agents.wrappers.RuleBasedStartWrapper]"]))

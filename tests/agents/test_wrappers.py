@@ -101,3 +101,51 @@ def test_solvable_starts_only_and_given_starts_kept():
         a.reset()
         b.reset()
         assert a.unwrapped.state == b.unwrapped.state
+
+
+def _rule_share(env, n: int, seed: int = 0) -> tuple[float, int]:
+    """Share of ``n`` resets whose start the rule-based method solves; resets the
+    wrapper chose."""
+    from graspgait_env.planners.rule_based import rule_based
+
+    u = env.unwrapped
+    env.reset(seed=seed)
+    solved = chosen = 0
+    for _ in range(n):
+        _, info = env.reset()
+        chosen += bool(info.get("rule_based_start"))
+        ok = rule_based(u.model, u.state, 360.0).success
+        assert ok or not info.get("rule_based_start")  # a chosen start is a rule-based one
+        solved += ok
+    return solved / n, chosen
+
+
+def test_rule_based_starts_make_a_quarter_of_the_hexagons_starts():
+    from agents.wrappers import RuleBasedStartWrapper, rule_based_starts
+    from graspgait_env.planners.rule_based import rule_based
+
+    make = lambda: gym.make("graspgait_env:GraspGait-v0", object="hexagon",  # noqa: E731
+                            mu=0.7, contact_model="hand")
+    bare, _ = _rule_share(make(), 200)
+    wrapped, chosen = _rule_share(RuleBasedStartWrapper(make()), 200)
+    assert bare < 0.12  # about 5% of the env's own starts
+    assert 30 <= chosen <= 72  # binomial(200, 0.25): mean 50, sd 6.1
+    assert wrapped >= chosen / 200 and wrapped > bare + 0.1
+    model = make().unwrapped.model
+    starts = rule_based_starts(model, 360.0)
+    assert 0 < len(starts) < len(model.start_states()) / 10
+    others = [s for s in model.start_states() if s not in starts]
+    assert not any(rule_based(model, s, 360.0).success for s in others[::25])
+    # reproducible from the first seed; a given start is kept
+    a, b = RuleBasedStartWrapper(make()), RuleBasedStartWrapper(make())
+    a.reset(seed=5)
+    b.reset(seed=5)
+    for _ in range(12):
+        assert a.reset()[1]["rule_based_start"] == b.reset()[1]["rule_based_start"]
+        assert a.unwrapped.state == b.unwrapped.state
+    bare_env = make()
+    bare_env.reset(seed=1)
+    given = bare_env.unwrapped.state
+    for _ in range(8):  # a given start is never replaced
+        _, info = a.reset(options={"start": given})
+        assert not info["rule_based_start"] and a.unwrapped.state == given
