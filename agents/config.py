@@ -221,6 +221,12 @@ class TrainConfig:
     (a curriculum, a fine-tune). The model must have this config's algorithm, observation
     and action spaces and network. The card records its steps and wall time
     (``init``), so the training a model took is stated in full."""
+    init_logit_scale: float = 1.0
+    """With ``init_model``: multiply the policy head's weights and bias (the action
+    logits) by this factor in (0, 1] before training. Below 1 the run starts from a
+    flatter policy with the same greedy actions, so actions the source model had ruled
+    out (probability ~0, never sampled, so never learned to be better) are tried again.
+    1.0 (the default): the weights as saved."""
 
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
@@ -307,6 +313,12 @@ class TrainConfig:
                                           "model's path or a shipped model's name, e.g. "
                                           "hexagon_explore")
             put("init_model", str(self.init_model))
+        put("init_logit_scale", check_number("init_logit_scale", self.init_logit_scale, 0.2,
+                                             minimum=0.0, maximum=1.0, strict=True))
+        if self.init_logit_scale != 1.0 and self.init_model is None:
+            raise GraspGaitInputError(
+                f"init_logit_scale={self.init_logit_scale}: scales the weights of "
+                "init_model, which is not set; set init_model or leave it at 1.0")
 
     @classmethod
     def field_names(cls) -> tuple[str, ...]:

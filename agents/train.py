@@ -300,7 +300,8 @@ def _callbacks(config: TrainConfig, run_dir: Path, card_base: dict[str, Any],
 
 
 def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
-    """Copy the policy and value weights of ``config.init_model`` into ``model``.
+    """Copy the policy and value weights of ``config.init_model`` into ``model``, the
+    policy head scaled by ``config.init_logit_scale``.
 
     Parameters
     ----------
@@ -346,6 +347,12 @@ def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
             f"init_model={str(path)!r}: its network does not fit this config's ({first}); "
             f"set net_arch={card.get('config', {}).get('net_arch')} and its features "
             "extractor") from None
+    if config.init_logit_scale != 1.0:  # a flatter policy, the same greedy actions
+        import torch
+
+        with torch.no_grad():
+            for param in model.policy.action_net.parameters():
+                param.mul_(config.init_logit_scale)
     before = card.get("init") or {}
     return {"model": str(config.init_model),
             "steps": int(card.get("steps") or 0) + int(before.get("steps") or 0),

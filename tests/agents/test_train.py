@@ -203,3 +203,27 @@ def test_train_wrappers_wrap_the_training_envs_only(tmp_path):
     with pytest.raises(GraspGaitInputError, match=r"vec_env='batched'.*train_wrappers"):
         make_vec_env_for(load_train_config("smoke", [
             "vec_env=batched", "train_wrappers=[agents.wrappers.RuleBasedStartWrapper]"]))
+
+
+def test_init_logit_scale_flattens_the_policy_and_keeps_its_greedy_actions(tmp_path, smoke_run):
+    src = smoke_run.model_path
+    cfg = load_train_config("smoke", [f"init_model={src}", "init_logit_scale=0.25"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    init_from_model(model, cfg)
+    source, _ = load_agent(src)
+    head = {id(p) for p in model.policy.action_net.parameters()}
+    for p, q in zip(model.policy.parameters(), source.policy.parameters(), strict=True):
+        assert torch.allclose(p, q * 0.25 if id(p) in head else q)
+    entropy = []
+    for obs, mask in _observations():
+        a0, _ = source.predict(obs, deterministic=True, action_masks=mask)
+        a1, _ = model.predict(obs, deterministic=True, action_masks=mask)
+        assert int(a0) == int(a1)
+        ob = torch.as_tensor(obs[None])
+        with torch.no_grad():
+            entropy.append([float(m.policy.get_distribution(ob, action_masks=mask[None])
+                                  .entropy()[0]) for m in (source, model)])
+    assert all(flat >= sharp - 1e-6 for sharp, flat in entropy)
+    assert sum(flat for _, flat in entropy) > sum(sharp for sharp, _ in entropy)
+    with pytest.raises(GraspGaitInputError, match=r"init_logit_scale=0.5: .*init_model"):
+        load_train_config("smoke", ["init_logit_scale=0.5"])
