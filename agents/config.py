@@ -102,6 +102,14 @@ def _check_import_path(name: str, value: Any) -> str:
     return value
 
 
+def _check_import_paths(name: str, value: Any, example: str) -> list[str]:
+    """A list of import paths (:func:`_check_import_path`), e.g. a wrappers field."""
+    if isinstance(value, str) or not isinstance(value, Sequence):
+        raise GraspGaitInputError(f"{name}={value!r}: must be a list of import paths, e.g. "
+                                  f"['{example}']")
+    return [_check_import_path(f"{name}[{i}]", v) for i, v in enumerate(value)]
+
+
 def _check_net_arch(value: Any) -> list[int] | dict[str, list[int]]:
     fix = "give a list of layer widths, e.g. [64, 64], or {pi: [64, 64], vf: [64, 64]}"
 
@@ -242,17 +250,10 @@ class TrainConfig:
             raise GraspGaitInputError(f"env_kwargs={self.env_kwargs!r}: must be a mapping, "
                                       "e.g. {object: ellipse, mu: 0.7}")
         put("env_kwargs", dict(self.env_kwargs))
-        if isinstance(self.wrappers, str) or not isinstance(self.wrappers, Sequence):
-            raise GraspGaitInputError(f"wrappers={self.wrappers!r}: must be a list of import "
-                                      "paths, e.g. ['agents.wrappers:LegalActionWrapper']")
-        put("wrappers", [_check_import_path(f"wrappers[{i}]", w)
-                         for i, w in enumerate(self.wrappers)])
-        if isinstance(self.train_wrappers, str) or not isinstance(self.train_wrappers, Sequence):
-            raise GraspGaitInputError(
-                f"train_wrappers={self.train_wrappers!r}: must be a list of import paths, "
-                "e.g. ['agents.wrappers:RuleBasedStartWrapper']")
-        put("train_wrappers", [_check_import_path(f"train_wrappers[{i}]", w)
-                               for i, w in enumerate(self.train_wrappers)])
+        put("wrappers", _check_import_paths("wrappers", self.wrappers,
+                                            "agents.wrappers:LegalActionWrapper"))
+        put("train_wrappers", _check_import_paths("train_wrappers", self.train_wrappers,
+                                                  "agents.wrappers:RuleBasedStartWrapper"))
         put("policy", _check_str("policy", self.policy, ("MlpPolicy",)))
         put("net_arch", _check_net_arch(self.net_arch))
         put("activation", _check_str("activation", self.activation, ACTIVATIONS))

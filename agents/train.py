@@ -40,7 +40,7 @@ from typing import Any
 import yaml
 from tqdm.auto import tqdm
 
-from agents.card import read_card, resolve_model, save_agent
+from agents.card import load_agent, read_card, resolve_model, save_agent
 from agents.config import TrainConfig
 from agents.envs import contact_model_of, import_object, make_env
 from agents.evaluate import (
@@ -327,11 +327,10 @@ def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
         raise GraspGaitInputError(f"init_model={str(config.init_model)!r}: no such model; "
                                   "give a saved model's path or a shipped model's name, "
                                   "e.g. hexagon_explore")
-    card = read_card(path)
-    if card.get("algo") not in (None, config.algo):
+    source, card = load_agent(path, device=config.device)  # its algo read from the zip
+    if card["algo"] != config.algo:
         raise GraspGaitInputError(f"init_model={str(path)!r}: a {card['algo']} model, the "
                                   f"config trains {config.algo}; set algo={card['algo']}")
-    source = _algo_class(config.algo).load(path, device=config.device)
     for what in ("observation_space", "action_space"):
         mine, theirs = getattr(model, what), getattr(source, what)
         if mine != theirs:

@@ -269,6 +269,20 @@ class RuleBasedStartWrapper(gym.Wrapper):
     fraction: float = 0.25
     """Probability that a reset draws a start where the rule-based gait exists."""
 
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self._model: Any = None  # the grasp map whose starts _starts holds
+        self._starts: list[Any] = []
+
+    def _rule_starts(self) -> list[Any]:
+        """The rule-based gait's starts of the env's present model (looked up once per
+        model, not per reset)."""
+        u = self.env.unwrapped
+        if u.model is not self._model:
+            self._model = u.model
+            self._starts = rule_based_starts(u.model, float(u.config.turn_deg))
+        return self._starts
+
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset; with probability :attr:`fraction`, from a rule-based gait's start."""
@@ -276,8 +290,7 @@ class RuleBasedStartWrapper(gym.Wrapper):
         info["rule_based_start"] = False
         if (options and "start" in options) or self.np_random.random() >= self.fraction:
             return obs, info
-        u = self.env.unwrapped
-        starts = rule_based_starts(u.model, float(u.config.turn_deg))
+        starts = self._rule_starts()
         if not starts:
             return obs, info
         start = starts[int(self.np_random.integers(len(starts)))]
