@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 from tqdm.auto import tqdm
 
+from agents.audit import audit_moves, summarize_audits
 from agents.card import load_agent
 from agents.envs import contact_model_of, env_kwargs_for, make_env
 from agents.seeding import seed_everything
@@ -91,6 +92,12 @@ class ReferenceGaits:
         """The exact optimum's regrasps for the turn from ``start`` (None: no gait), from
         the model's cached table (:class:`~graspgait_env.planners.exact.RegraspsToGo`
         over ``optimal_gait``'s window)."""
+        return self.to_go(model, start, turn_deg)
+
+    def to_go(self, model: GaitModel, state: GaitState, turn_deg: float) -> int | None:
+        """The optimum's fewest regrasps for the turn from any gait state ``state`` (None:
+        no gait from it, or it lies outside the window), from the same cached table as
+        :meth:`optimal_regrasps` (:mod:`agents.audit` prices moves with it)."""
         from graspgait_env.planners.exact import RegraspsToGo
 
         key = (self._model_key(model), model.turn_steps(turn_deg))
@@ -100,7 +107,7 @@ class ReferenceGaits:
                 self._tables.clear()
             # optimal_gait searches one full turn (n grid steps, 360 deg) against the turn
             table = self._tables[key] = RegraspsToGo(model, turn_deg, 360.0)
-        g = table(start)
+        g = table(state)
         return None if g < 0 else int(g)
 
     def model_key(self, model: GaitModel) -> tuple:
@@ -171,8 +178,8 @@ def _start_dict(model: GaitModel, s: GaitState) -> dict[str, float]:
 
 
 def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
-                 seed: int | None = None, options: Mapping[str, Any] | None = None
-                 ) -> dict[str, Any]:
+                 seed: int | None = None, options: Mapping[str, Any] | None = None,
+                 record_states: bool = False) -> dict[str, Any]:
     """Reset ``env`` (``seed``, ``options``) and play one episode with ``predict``.
 
     Returns
@@ -182,7 +189,8 @@ def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
         episode), ``success``, ``regrasps``, ``path_length`` (moves made: a move changes
         the (commanded) gait state, an illegal no-op does not), ``steps``,
         ``illegal_actions`` (actions chosen that were not legal moves), ``turn_deg``
-        (turn achieved, degrees) and ``wall_s``.
+        (turn achieved, degrees) and ``wall_s``; with ``record_states``, ``states``: the
+        start and the state after each move (``path_length + 1`` states).
     """
     u = env.unwrapped
     t0 = time.perf_counter()
@@ -190,6 +198,7 @@ def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
     model, start = u.model, u.state
     steps = illegal = moves = 0
     state, done = start, False
+    states = [start]
     while not done:
         mask = np.asarray(u.action_masks(), dtype=bool)
         action = int(predict(obs, mask))
@@ -197,19 +206,25 @@ def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
         obs, _, terminated, truncated, info = env.step(np.int64(action))
         steps += 1
         moved = u.state
-        moves += moved != state
+        if moved != state:
+            moves += 1
+            states.append(moved)
         state = moved
         done = terminated or truncated
-    return {"model": model, "start_state": start,
-            "success": bool(info.get("is_success", False)),
-            "regrasps": int(info.get("regrasps", 0)), "path_length": moves, "steps": steps,
-            "illegal_actions": illegal, "turn_deg": float(info.get("turn_deg", 0.0)),
-            "wall_s": time.perf_counter() - t0}
+    out = {"model": model, "start_state": start,
+           "success": bool(info.get("is_success", False)),
+           "regrasps": int(info.get("regrasps", 0)), "path_length": moves, "steps": steps,
+           "illegal_actions": illegal, "turn_deg": float(info.get("turn_deg", 0.0)),
+           "wall_s": time.perf_counter() - t0}
+    if record_states:
+        out["states"] = states
+    return out
 
 
 def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, episodes: int,
                  seed: int = 0, references: ReferenceGaits | None = None,
-                 progress: bool = False, desc: str = "evaluate") -> list[dict[str, Any]]:
+                 progress: bool = False, desc: str = "evaluate", audit: bool = False
+                 ) -> list[dict[str, Any]]:
     """Play ``episodes`` episodes with ``predict`` and compare each with the references.
 
     Parameters
@@ -226,6 +241,9 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
         Cache of optimal and rule-based regrasps (a fresh one when None).
     progress
         Show a tqdm bar.
+    audit
+        Add ``audit`` to each record: every move priced against the optimum
+        (:func:`agents.audit.audit_moves`).
 
     Returns
     -------
@@ -242,16 +260,20 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
     turn = float(env.unwrapped.config.turn_deg)
     out = []
     for i in tqdm(range(episodes), desc=desc, disable=not progress, unit="ep"):
-        ep = play_episode(predict, env, seed=seed + i)
+        ep = play_episode(predict, env, seed=seed + i, record_states=audit)
         model, start = ep.pop("model"), ep.pop("start_state")
         opt, rule = refs.regrasps(model, start, turn)
-        out.append({
+        record = {
             "start": _start_dict(model, start), "object": model.shape.name,
             "mu": float(model.mu), "success": ep["success"], "solvable": opt is not None,
             "regrasps": ep["regrasps"], "path_length": ep["path_length"],
             "steps": ep["steps"], "illegal_actions": ep["illegal_actions"],
             "optimal_regrasps": opt, "rule_regrasps": rule, "wall_s": ep["wall_s"],
-        })
+        }
+        if audit:
+            record["audit"] = audit_moves(model, ep["states"], turn,
+                                          lambda st, m=model: refs.to_go(m, st, turn))
+        out.append(record)
     return out
 
 
@@ -437,7 +459,7 @@ def agent_batch_predictor(model: Any) -> Callable[[np.ndarray, np.ndarray], np.n
 def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
              object: Any = None, mu: float | None = None, episodes: int = 100, seed: int = 0,
              deterministic: bool = True, env_overrides: Mapping[str, Any] | None = None,
-             progress: bool = False) -> dict[str, Any]:
+             progress: bool = False, audit: bool = False) -> dict[str, Any]:
     """Evaluate a saved agent (``model.zip``) and compare it with the optimum and the rules.
 
     Parameters
@@ -468,6 +490,12 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         procedural objects in ``GraspGaitRandom-v0``).
     progress
         Show a progress bar.
+    audit
+        Price every move against the optimum (:mod:`agents.audit`): each record gains
+        ``audit``, the result ``audit``, the sums over the successful episodes from
+        solvable starts (their ``excess_regrasps`` is the agent's regrasps there less
+        the optimum's). The episodes are then played one by one (the same records as
+        side by side, tested; slower).
 
     Returns
     -------
@@ -475,7 +503,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         The aggregate numbers of :func:`summarize_episodes`, the per-episode records
         under ``episodes``, and ``model`` (path, algo, card), ``env_id``, ``env_kwargs``,
         ``object``, ``mu`` (None when drawn per episode), ``contact_model``, ``seed``,
-        ``deterministic``, ``wall_s``.
+        ``deterministic``, ``wall_s``; with ``audit``, ``audit``.
 
     Raises
     ------
@@ -509,7 +537,8 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
                 f"env {env_id} gives {env.observation_space.shape}; evaluate with the env "
                 "settings the model was trained with (hand, n, map window)")
         venv = (batched_eval_env(env_id, kwargs, card.get("wrappers") or (),
-                                 min(episodes, EVAL_BATCH)) if deterministic else None)
+                                 min(episodes, EVAL_BATCH))
+                if deterministic and not audit else None)
         if venv is not None:  # the same episodes side by side: one policy call per step
             try:
                 records = run_episodes_batched(agent_batch_predictor(model), venv, episodes,
@@ -518,11 +547,14 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
                 venv.close()
         else:
             records = run_episodes(agent_predictor(model, deterministic), env, episodes,
-                                   seed, progress=progress)
+                                   seed, progress=progress, audit=audit)
         contact_model = contact_model_of(env)
     finally:
         env.close()
     summary = summarize_episodes(records)
+    if audit:
+        summary["audit"] = summarize_audits([r["audit"] for r in records
+                                             if r["success"] and r["solvable"]])
     objects = sorted({r["object"] for r in records})
     mus = sorted({r["mu"] for r in records})
     return {
@@ -574,6 +606,14 @@ def format_evaluation(result: Mapping[str, Any]) -> str:
         f"{f(result['mean_optimal_regrasps'])} (x{f(result['regrasps_vs_optimal'], '.3f')}), "
         f"rule-based {f(result['mean_rule_regrasps'])} "
         f"(agent/rule x{f(result['regrasps_vs_rule'], '.3f')})",
+        *([_format_audit(result["audit"])] if result.get("audit") else []),
         f"illegal actions {f(result['illegal_action_rate'], '.1%')}; "
         f"wall time {result['wall_s']:.1f} s",
     ])
+
+
+def _format_audit(a: Mapping[str, Any]) -> str:
+    return (f"beyond the optimum ({a['episodes']} successful episodes): "
+            f"{a['excess_regrasps']} regrasps = {a['idle_regrasps']} idle regrasps + "
+            f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing regrasps + "
+            f"{a['excess_of_losing_rotations']} from {a['losing_rotations']} losing rotations")

@@ -711,6 +711,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         raise GraspGaitInputError(f"--seed {args.seed}: must be >= 0, e.g. 0")
     env_set = apply_overrides({"env_kwargs": {}},
                               [f"env_kwargs.{s}" for s in args.set or []])["env_kwargs"]
+    if args.ray is not None and args.audit:
+        raise GraspGaitInputError("--audit with --ray: the audit runs in this process; "
+                                  "drop --ray (or --audit)")
     if args.ray is not None:
         from agents.ray_train import evaluate_on_ray
 
@@ -720,7 +723,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     else:
         result = evaluate(args.model, env_id=args.env, object=args.object, mu=mu,
                           episodes=args.episodes, seed=args.seed, env_overrides=env_set,
-                          progress=not args.quiet)
+                          progress=not args.quiet, audit=args.audit)
     print(format_evaluation(result))
     if args.json:
         _write_output("--json", args.json, lambda: write_evaluation(result, args.json))
@@ -747,6 +750,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    help="an env keyword argument (YAML value), e.g. bundled_fraction=0; "
                    "repeatable")
     p.add_argument("--json", metavar="FILE", help="write the result JSON (per-episode records)")
+    p.add_argument("--audit", action="store_true",
+                   help="price every move against the optimum: where the regrasps beyond "
+                   "it go (idle regrasps, losing regrasps, losing rotations; agents.audit)")
     _add_ray_option(p, "split the episodes over Ray tasks; same result as serially")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_evaluate)
