@@ -198,7 +198,7 @@ def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
     model, start = u.model, u.state
     steps = illegal = moves = 0
     state, done = start, False
-    states = [start]
+    states = [start]  # with record_states
     while not done:
         mask = np.asarray(u.action_masks(), dtype=bool)
         action = int(predict(obs, mask))
@@ -208,7 +208,8 @@ def play_episode(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, *,
         moved = u.state
         if moved != state:
             moves += 1
-            states.append(moved)
+            if record_states:
+                states.append(moved)
         state = moved
         done = terminated or truncated
     out = {"model": model, "start_state": start,

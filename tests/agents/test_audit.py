@@ -86,8 +86,7 @@ def test_the_shipped_hexagon_agents_losing_regrasp():
     """Traced by hand (agents/models/hexagon.md): from fingers 1 and 3 at 90/274 deg the
     shipped agent's third move is a regrasp after which the optimum needs 19 regrasps
     instead of 18, its only loss: 21 regrasps where the optimum needs 19."""
-    from agents.bench import shipped_models_dir
-    from agents.card import load_agent
+    from agents.card import load_agent, shipped_models_dir
     from agents.envs import make_env
     from agents.evaluate import agent_predictor
 
