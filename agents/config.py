@@ -163,7 +163,10 @@ class TrainConfig:
     evaluation and ``graspgait evaluate`` run without them, and the card's ``wrappers``
     leaves them out."""
     policy: str = "MlpPolicy"
-    """SB3 policy name (``MlpPolicy``)."""
+    """SB3's ``MlpPolicy``, or the import path of a policy class: with ``algo:
+    maskable_ppo``, ``agents.policies:MaskableRegraspScorerPolicy`` (SB3's network plus a
+    regrasp scorer shared by every regrasp action; needs ``features_extractor:
+    agents.policies:GraspMapExtractor`` with ``workspace_widths``)."""
     net_arch: list[int] | dict[str, list[int]] = field(default_factory=lambda: [64, 64])
     """Hidden layer widths of the policy and value networks (a list: shared sizes, separate
     networks; or ``{pi: [...], vf: [...]}``)."""
@@ -222,8 +225,8 @@ class TrainConfig:
     run_root: str = "runs"
     """Folder under which each run gets its own folder."""
     init_model: str | None = None
-    """A saved model (a ``.zip`` path, or a shipped model's name: ``hexagon_explore`` is
-    ``agents/models/hexagon_explore.zip``) whose policy and value weights start this run,
+    """A saved model (a ``.zip`` path, or a shipped model's name: ``ellipse`` is
+    ``agents/models/ellipse.zip``) whose policy and value weights start this run,
     or None (a fresh network). Only the weights carry over: the optimizer, the step count and the
     learning-rate schedule start afresh, so a run can continue another under a new reward
     (a curriculum, a fine-tune). The model must have this config's algorithm, observation
@@ -254,7 +257,12 @@ class TrainConfig:
                                             "agents.wrappers:LegalActionWrapper"))
         put("train_wrappers", _check_import_paths("train_wrappers", self.train_wrappers,
                                                   "agents.wrappers:RuleBasedStartWrapper"))
-        put("policy", _check_str("policy", self.policy, ("MlpPolicy",)))
+        if self.policy != "MlpPolicy":
+            put("policy", _check_import_path("policy", self.policy))
+            if self.algo != "maskable_ppo" and "Maskable" in self.policy:
+                raise GraspGaitInputError(
+                    f"policy={self.policy!r} with algo={self.algo!r}: a maskable policy "
+                    "needs algo: maskable_ppo; set it, or policy: MlpPolicy")
         put("net_arch", _check_net_arch(self.net_arch))
         put("activation", _check_str("activation", self.activation, ACTIVATIONS))
         if self.features_extractor is not None:
@@ -312,7 +320,7 @@ class TrainConfig:
             if not isinstance(self.init_model, (str, os.PathLike)) or not str(self.init_model):
                 raise GraspGaitInputError(f"init_model={self.init_model!r}: must be a saved "
                                           "model's path or a shipped model's name, e.g. "
-                                          "hexagon_explore")
+                                          "ellipse")
             put("init_model", str(self.init_model))
         put("init_logit_scale", check_number("init_logit_scale", self.init_logit_scale, 0.2,
                                              minimum=0.0, maximum=1.0, strict=True))

@@ -1,4 +1,5 @@
-"""Policy networks for the GraspGait observation: convolutions over the grasp map's views.
+"""Policy networks for the GraspGait observation: convolutions over the grasp map's views,
+and a policy that scores every regrasp with one shared network.
 
 :class:`GraspMapExtractor` is an SB3 features extractor (``features_extractor:
 agents.policies:GraspMapExtractor`` in a training config). It splits the flat
@@ -51,6 +52,11 @@ With a linear policy head on them (``net_arch: {pi: [], vf: [...]}``) a logit ca
 weight times one of these entries, which a hidden layer narrower than the action space
 cannot pass through for every action; the weights are learned, nothing forces the
 forward gait.
+The **regrasp block** (``regrasp_block``, set by :class:`MaskableRegraspScorerPolicy`):
+for each regrasp action, :data:`REGRASP_CHANNELS` entries computed from the observation
+(:meth:`GraspMapExtractor.regrasp_block`), which that policy's shared scorer reads, one
+regrasp at a time; they follow every other feature and the policy keeps them out of
+its MLPs.
 Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
 through unchanged too. The features are the concatenation (header and mask, window
 features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
@@ -63,16 +69,22 @@ as any other (``tests/agents/test_policies.py``).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import partial
+from typing import Any
 
 import gymnasium as gym
 import torch
-from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor, MlpExtractor
 from torch import nn
 
 from graspgait_env.envs.map_env import ObservationLayout
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["GraspMapExtractor", "layout_of"]
+__all__ = ["REGRASP_CHANNELS", "GraspMapExtractor", "MaskableRegraspScorerPolicy", "layout_of"]
+
+REGRASP_CHANNELS = 9
+"""Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
 
 _HEADER = 16  # ObservationLayout's header: held, positions, contact and object angles, turn
 
@@ -134,6 +146,10 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         180``); adds the forward-gait features. None (default): none.
     best_regrasp
         With ``workspace_widths``: add the one-hot of the regrasps with the most room.
+    regrasp_block
+        With ``workspace_widths``: append :meth:`regrasp_block`, flattened (``2 W x``
+        :data:`REGRASP_CHANNELS` entries, after every other feature), for
+        :class:`MaskableRegraspScorerPolicy`, which sets it and reads the block apart.
     turn_steps
         The requested turn in grid steps, signed (``turn_deg / (360 / n)``: 180 for the
         default 360° at ``n = 180``); with ``rotations``, adds the finishing rotations.
@@ -153,7 +169,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
     def __init__(self, observation_space: gym.spaces.Box, cells: int = 36, line_cells: int = 0,
                  tail: int = 0, conv: bool = True, turn_steps: int = 0, rotations: int = 0,
                  shortfall_bins: int = 0, workspace_widths: Sequence[int] | None = None,
-                 best_regrasp: bool = False,
+                 best_regrasp: bool = False, regrasp_block: bool = False,
                  window_channels: Sequence[int] = (8, 16),
                  line_channels: Sequence[int] = (8, 16),
                  window_features: int = 64, line_features: int = 64) -> None:
@@ -192,9 +208,21 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                     f"2 x the widest = the {n_regrasp} regrasp actions), with turn_steps and "
                     "rotations, e.g. [46, 46, 46] for the thesis hand at n = 180")
             n_forward = int(rotations) + (2 if best_regrasp else 1) * n_regrasp
+        elif regrasp_block:
+            raise GraspGaitInputError(
+                "features_extractor_kwargs regrasp_block=True: needs workspace_widths, "
+                "turn_steps and rotations (the block is computed from them), e.g. "
+                "workspace_widths: [46, 46, 46], turn_steps: 180, rotations: 45")
+        n_block = n_regrasp * REGRASP_CHANNELS if regrasp_block else 0
         super().__init__(observation_space,
                          width + int(tail) + (int(rotations) if finishing else 0)
-                         + self.shortfall_bins + n_forward)
+                         + self.shortfall_bins + n_forward + n_block)
+        self.with_block = bool(regrasp_block)
+        #: where the regrasp actions lie in the action space (first index, count) and
+        #: how many features precede the regrasp block (with ``regrasp_block``)
+        self.regrasp_actions = ((2 * int(rotations), n_block // REGRASP_CHANNELS)
+                                if regrasp_block else (0, 0))
+        self.block_start = self.features_dim - n_block
         self.gait_features = widths is not None
         self.best_regrasp = bool(best_regrasp) and widths is not None
         if widths is not None:
@@ -203,6 +231,8 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                                  persistent=False)
             self.register_buffer("_positions", torch.arange(w_max, dtype=torch.float32),
                                  persistent=False)
+            self.register_buffer("_lift", torch.arange(2 * w_max, dtype=torch.float32)[None, :]
+                                 % 2, persistent=False)
         self.layout, self.n_flat, self.tail, self.conv = layout, n_flat, int(tail), bool(conv)
         self.cells, self.line_cells = int(cells), int(line_cells)
         self.turn_steps, self.rotations = int(turn_steps), int(rotations) if finishing else 0
@@ -262,17 +292,13 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         short = torch.clamp(self._steps_to_go(observations) - reach, min=0.0)
         return (short > self._thresholds).to(observations.dtype)
 
-    def forward_gait_features(self, observations: torch.Tensor) -> torch.Tensor:
-        """``(batch, R + 2 W)``: the longest legal rotation towards the goal (one-hot over
-        the ``R`` rotations that way), then for each regrasp action ``2p + l`` the room
-        the grasp it makes leaves for a rotation towards the goal, over ``R`` (0 where the
-        regrasp is illegal); with ``best_regrasp`` ``2 W`` more, a one-hot of the legal
-        regrasps with the most room (all 0 when none leaves any); see the module
-        docstring."""
+    def _regrasp_geometry(self, observations: torch.Tensor) -> dict[str, torch.Tensor]:
+        """Per regrasp action ``2q + l`` (``(batch, 2 W)`` each): ``legal`` (the mask),
+        ``goal`` and ``back`` (the rotation room towards and away from the goal of the
+        grasp it makes, grid steps, clamped at 0, thesis 5.2), ``q`` (the new
+        position over ``W_h - 1``), ``l`` (which held finger is lifted) and ``kept`` (the
+        kept finger's position over its ``W - 1``)."""
         lay, R = self.layout, self.rotations
-        legal_rot = self._goal_rotations(observations)
-        reach = (legal_rot * self._steps).amax(dim=1, keepdim=True)
-        longest = legal_rot * (self._steps == reach).to(legal_rot.dtype)
         held = observations[:, 0:3]
         wd = self._widths
         p = torch.round(observations[:, 3:6] * (wd - 1))  # workspace positions (free: < 0)
@@ -281,17 +307,65 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         g = torch.where(h == 2, 1, 2)
         w_h, w_f, w_g = wd[h], wd[f], wd[g]
         p_f, p_g = p.gather(1, f), p.gather(1, g)
-        q = self._positions[None, :]  # the free finger's new position
-        if self.turn_steps > 0:  # counter-clockwise room: min(W - 1 - p) over the pair
-            keep_g = torch.minimum(w_h - 1 - q, w_g - 1 - p_g)
-            keep_f = torch.minimum(w_h - 1 - q, w_f - 1 - p_f)
-        else:  # clockwise room: min(p) over the pair
-            qb = q.expand(p.shape[0], -1)
-            keep_g, keep_f = torch.minimum(qb, p_g), torch.minimum(qb, p_f)
-        room = torch.stack((keep_g, keep_f), dim=2).reshape(p.shape[0], -1)  # 2p + l
+        q = self._positions[None, :].expand(p.shape[0], -1)  # the free finger's new position
+        ccw_g = torch.minimum(w_h - 1 - q, w_g - 1 - p_g)  # counter-clockwise room
+        ccw_f = torch.minimum(w_h - 1 - q, w_f - 1 - p_f)
+        cw_g, cw_f = torch.minimum(q, p_g), torch.minimum(q, p_f)  # clockwise room
+        if self.turn_steps > 0:
+            goal_g, goal_f, back_g, back_f = ccw_g, ccw_f, cw_g, cw_f
+        else:
+            goal_g, goal_f, back_g, back_f = cw_g, cw_f, ccw_g, ccw_f
+
+        def pairs(keep_g: torch.Tensor, keep_f: torch.Tensor) -> torch.Tensor:
+            return torch.stack((keep_g, keep_f), dim=2).reshape(p.shape[0], -1)  # 2q + l
+
         start = lay.mask.start + 2 * R
-        legal_reg = observations[:, start:start + room.shape[1]]
-        room = legal_reg * torch.clamp(room, min=0.0) / R
+        legal = observations[:, start:start + 2 * q.shape[1]]
+        kept = pairs((p_g / torch.clamp(w_g - 1, min=1.0)).expand_as(q),
+                     (p_f / torch.clamp(w_f - 1, min=1.0)).expand_as(q))
+        return {"legal": legal,
+                "goal": legal * torch.clamp(pairs(goal_g, goal_f), min=0.0),
+                "back": legal * torch.clamp(pairs(back_g, back_f), min=0.0),
+                "q": pairs(q, q) / torch.clamp(w_h - 1, min=1.0),
+                "l": self._lift.expand(p.shape[0], -1),
+                "kept": kept * (kept >= 0).to(kept.dtype)}
+
+    def regrasp_block(self, observations: torch.Tensor,
+                      geometry: dict[str, torch.Tensor] | None = None) -> torch.Tensor:
+        """``(batch, 2 W, REGRASP_CHANNELS)``: for each regrasp action ``2q + l``, the
+        entries :class:`MaskableRegraspScorerPolicy` scores it by, all read off the
+        observation (see the module docstring): legal; rotation room towards the goal and
+        away from it, over ``R``; the new position ``q`` and the kept finger's position,
+        each over its ``W - 1``; ``l``; whether the regrasps to the neighbouring positions
+        ``q - 1`` and ``q + 1`` with the same lift are legal (a proxy for how far the
+        new grasp lies inside the force-closure region); and 1 for the legal regrasps
+        with the most room towards the goal (thesis 6.3.1's choice)."""
+        geo = self._regrasp_geometry(observations) if geometry is None else geometry
+        legal, R = geo["legal"], float(self.rotations)
+        b = legal.shape[0]
+        by_q = legal.reshape(b, -1, 2)  # [batch, q, l]
+        zero = torch.zeros_like(by_q[:, :1])
+        below = torch.cat((zero, by_q[:, :-1]), dim=1).reshape(b, -1)
+        above = torch.cat((by_q[:, 1:], zero), dim=1).reshape(b, -1)
+        goal = geo["goal"]
+        most = goal.amax(dim=1, keepdim=True)
+        best = ((goal == most) & (most > 0)).to(goal.dtype) * legal
+        return torch.stack((legal, goal / R, geo["back"] / R, geo["q"], geo["kept"], geo["l"],
+                            below, above, best), dim=2)
+
+    def forward_gait_features(self, observations: torch.Tensor,
+                              geometry: dict[str, torch.Tensor] | None = None) -> torch.Tensor:
+        """``(batch, R + 2 W)``: the longest legal rotation towards the goal (one-hot over
+        the ``R`` rotations that way), then for each regrasp action ``2p + l`` the room
+        the grasp it makes leaves for a rotation towards the goal, over ``R`` (0 where the
+        regrasp is illegal); with ``best_regrasp`` ``2 W`` more, a one-hot of the legal
+        regrasps with the most room (all 0 when none leaves any); see the module
+        docstring."""
+        legal_rot = self._goal_rotations(observations)
+        reach = (legal_rot * self._steps).amax(dim=1, keepdim=True)
+        longest = legal_rot * (self._steps == reach).to(legal_rot.dtype)
+        geo = self._regrasp_geometry(observations) if geometry is None else geometry
+        room = geo["goal"] / self.rotations
         if not self.best_regrasp:
             return torch.cat((longest, room), dim=1)
         most = room.amax(dim=1, keepdim=True)
@@ -317,5 +391,147 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         if self.shortfall_bins:
             parts.append(self.shortfall_code(observations))
         if self.gait_features:
-            parts.append(self.forward_gait_features(observations))
+            geo = self._regrasp_geometry(observations)  # once for both users
+            parts.append(self.forward_gait_features(observations, geo))
+        if self.with_block:
+            parts.append(self.regrasp_block(observations, geo).reshape(b, -1))
         return torch.cat(parts, dim=1)
+
+
+class _ScorerExtractor(nn.Module):
+    """SB3's ``MlpExtractor`` over the features before the regrasp block, and beside it
+    the regrasp scorer: one small MLP, shared by every regrasp action, from that
+    action's block entries and a context read off the policy latent to one score.
+    ``forward_actor`` returns ``[policy latent, one score per regrasp action]``."""
+
+    def __init__(self, base_dim: int, n_regrasp: int, net_arch: Any, activation_fn: type,
+                 scorer_arch: Sequence[int], context: int, device: Any) -> None:
+        super().__init__()
+        self.mlp = MlpExtractor(base_dim, net_arch=net_arch, activation_fn=activation_fn,
+                                device=device)
+        self.base_dim, self.n_regrasp = int(base_dim), int(n_regrasp)
+        self.context = nn.Sequential(nn.Linear(self.mlp.latent_dim_pi, int(context)), nn.ReLU())
+        layers: list[nn.Module] = []
+        c_in = REGRASP_CHANNELS + int(context)
+        for width in scorer_arch:
+            layers += [nn.Linear(c_in, int(width)), nn.ReLU()]
+            c_in = int(width)
+        self.score = nn.Linear(c_in, 1)
+        self.scorer = nn.Sequential(*layers, self.score)
+        self.latent_dim_pi = self.mlp.latent_dim_pi + self.n_regrasp
+        self.latent_dim_vf = self.mlp.latent_dim_vf
+
+    def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.forward_actor(features), self.forward_critic(features)
+
+    def forward_actor(self, features: torch.Tensor) -> torch.Tensor:
+        b = features.shape[0]
+        latent = self.mlp.forward_actor(features[:, :self.base_dim])
+        block = features[:, self.base_dim:].reshape(b, self.n_regrasp, REGRASP_CHANNELS)
+        context = self.context(latent)[:, None, :].expand(-1, self.n_regrasp, -1)
+        scores = self.scorer(torch.cat((block, context), dim=2)).squeeze(2)
+        return torch.cat((latent, scores), dim=1)
+
+    def forward_critic(self, features: torch.Tensor) -> torch.Tensor:
+        return self.mlp.forward_critic(features[:, :self.base_dim])
+
+
+class _ScoredActionNet(nn.Module):
+    """The action logits: a linear layer over the policy latent (SB3's ``action_net``)
+    plus, on the regrasp actions, the scorer's scores times ``gain`` (a fixed 1, a
+    parameter so that scaling the head's parameters, ``init_logit_scale``, scales every
+    logit)."""
+
+    def __init__(self, latent_dim: int, n_actions: int, regrasp_actions: tuple[int, int]) -> None:
+        super().__init__()
+        self.latent_dim = int(latent_dim)
+        self.linear = nn.Linear(self.latent_dim, int(n_actions))
+        self.gain = nn.Parameter(torch.ones(()), requires_grad=False)
+        first, count = regrasp_actions
+        self.pad = (int(first), int(n_actions) - int(first) - int(count))
+
+    def forward(self, latent: torch.Tensor) -> torch.Tensor:
+        scores = nn.functional.pad(latent[:, self.latent_dim:] * self.gain, self.pad)
+        return self.linear(latent[:, :self.latent_dim]) + scores
+
+
+class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
+    """sb3-contrib's maskable actor-critic with a **shared regrasp scorer**.
+
+    ``policy: agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
+    ``algo: maskable_ppo`` and ``features_extractor: agents.policies:GraspMapExtractor``
+    given ``workspace_widths``, ``turn_steps`` and ``rotations``; the policy sets the
+    extractor's ``regrasp_block``).
+
+    Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent)
+    and, for a regrasp action ``2R + 2q + l`` (thesis 4.2's move: the free finger to
+    workspace position ``q``, held finger ``l`` lifted), plus a score of that regrasp:
+    one MLP (``scorer_arch``), the same for every regrasp, over the regrasp's entries of
+    :meth:`GraspMapExtractor.regrasp_block` (its legality, the rotation room towards
+    and away from the goal of the grasp it makes, positions, whether its neighbouring
+    regrasps are legal, whether it has the most room) and a ``scorer_context``-wide
+    ReLU projection of the policy latent (what the state asks for). The value head is
+    SB3's.
+
+    Why: with a flat head every regrasp action has its own output weights, so what the
+    agent learns of a regrasp at one workspace position (e.g. that one leaving no
+    rotation room towards the goal loses a regrasp) does not carry to the same kind of
+    regrasp at another; the shared scorer prices every regrasp by the same function of
+    what it does. It only re-weights legal moves, computed from the observation; it
+    never sees the optimum's regrasps to go. Measured in ``agents/models/*.md``.
+
+    Parameters
+    ----------
+    *args, **kwargs
+        Those of ``MaskableActorCriticPolicy`` (SB3 passes them).
+    scorer_arch
+        Hidden layer widths of the scorer (ReLU), default ``(32,)``.
+    scorer_context
+        Width of the context the scorer reads off the policy latent, default 16.
+    """
+
+    def __init__(self, *args: Any, scorer_arch: Sequence[int] = (32,), scorer_context: int = 16,
+                 **kwargs: Any) -> None:
+        extractor = kwargs.get("features_extractor_class")
+        if extractor is None or not issubclass(extractor, GraspMapExtractor):
+            raise GraspGaitInputError(
+                f"policy MaskableRegraspScorerPolicy with features_extractor {extractor!r}: "
+                "needs agents.policies:GraspMapExtractor (it computes the regrasp block); "
+                "set features_extractor: agents.policies:GraspMapExtractor with "
+                "workspace_widths, turn_steps and rotations")
+        kwargs["features_extractor_kwargs"] = {**(kwargs.get("features_extractor_kwargs") or {}),
+                                               "regrasp_block": True}
+        if kwargs.get("share_features_extractor") is False:
+            raise GraspGaitInputError("policy MaskableRegraspScorerPolicy: "
+                                      "share_features_extractor=False is not supported; "
+                                      "leave it at True")
+        if int(scorer_context) < 1 or any(int(w) < 1 for w in scorer_arch):
+            raise GraspGaitInputError(
+                f"scorer_arch={list(scorer_arch)!r}, scorer_context={scorer_context!r}: "
+                "widths must be positive integers, e.g. scorer_arch: [32], scorer_context: 16")
+        # read by _build, which the base __init__ calls
+        self.scorer_arch = [int(w) for w in scorer_arch]
+        self.scorer_context = int(scorer_context)
+        super().__init__(*args, **kwargs)
+
+    def _build_mlp_extractor(self) -> None:
+        fx = self.features_extractor
+        self.mlp_extractor = _ScorerExtractor(fx.block_start, fx.regrasp_actions[1],
+                                              self.net_arch, self.activation_fn,
+                                              self.scorer_arch, self.scorer_context, self.device)
+
+    def _build(self, lr_schedule: Any) -> None:
+        super()._build(lr_schedule)
+        latent = self.mlp_extractor.mlp.latent_dim_pi
+        self.action_net = _ScoredActionNet(latent, int(self.action_space.n),
+                                           self.features_extractor.regrasp_actions)
+        if self.ortho_init:  # SB3's small initial logits, the scorer's output included
+            self.action_net.linear.apply(partial(self.init_weights, gain=0.01))
+            self.mlp_extractor.score.apply(partial(self.init_weights, gain=0.01))
+        self.optimizer = self.optimizer_class(self.parameters(), lr=lr_schedule(1),
+                                              **self.optimizer_kwargs)
+
+    def _get_constructor_parameters(self) -> dict[str, Any]:
+        data = super()._get_constructor_parameters()
+        data.update(scorer_arch=self.scorer_arch, scorer_context=self.scorer_context)
+        return data

@@ -191,8 +191,10 @@ def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = Non
         def lr(progress_remaining: float) -> float:  # SB3: 1 at the start, 0 at the end
             return lr0 * progress_remaining
 
+    policy: Any = (config.policy if config.policy == "MlpPolicy"
+                   else import_object(config.policy, "policy"))
     return _algo_class(config.algo)(
-        config.policy, env, learning_rate=lr, n_steps=config.n_steps,
+        policy, env, learning_rate=lr, n_steps=config.n_steps,
         batch_size=config.batch_size, n_epochs=config.n_epochs, gamma=config.gamma,
         gae_lambda=config.gae_lambda, clip_range=config.clip_range, ent_coef=config.ent_coef,
         vf_coef=config.vf_coef, max_grad_norm=config.max_grad_norm,
@@ -326,7 +328,7 @@ def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
     if not path.is_file():
         raise GraspGaitInputError(f"init_model={str(config.init_model)!r}: no such model; "
                                   "give a saved model's path or a shipped model's name, "
-                                  "e.g. hexagon_explore")
+                                  "e.g. ellipse")
     source, card = load_agent(path, device=config.device)  # its algo read from the zip
     if card["algo"] != config.algo:
         raise GraspGaitInputError(f"init_model={str(path)!r}: a {card['algo']} model, the "

@@ -82,28 +82,29 @@ def test_a_move_into_a_state_without_a_gait_ends_the_pricing(ellipse_env):
         "excess_regrasps"] == 0
 
 
-def test_the_shipped_hexagon_agents_losing_regrasp():
-    """Traced by hand (agents/models/hexagon.md): from fingers 1 and 3 at 90/274 deg the
-    shipped agent's third move is a regrasp after which the optimum needs 19 regrasps
-    instead of 18, its only loss: 21 regrasps where the optimum needs 19."""
+@pytest.mark.parametrize("start", [(90.0, 274.0), (74.0, 272.0)])
+def test_the_shipped_hexagon_agent_is_optimal_from_the_rule_based_gaits_starts(start):
+    """Measured (agents/models/hexagon.md): from the two starts of seeds 0-99 from which
+    the rule-based method finds a gait under the hand's contact model (fingers 1 and 3),
+    the shipped agent needs the optimum's 19 regrasps, no more than that gait's; the
+    audit finds no losing move. The agent before it needed 21 from 90/274 deg."""
     from agents.card import load_agent, shipped_models_dir
     from agents.envs import make_env
     from agents.evaluate import agent_predictor
 
-    path = shipped_models_dir() / "hexagon.zip"
-    model, card = load_agent(path)
+    model, card = load_agent(shipped_models_dir() / "hexagon.zip")
     env = make_env(card["env_id"], card["env_kwargs"])
     u = env.unwrapped
     env.reset(seed=0)
-    start = u.model.start_state({1: 90.0, 3: 274.0})
-    ep = play_episode(agent_predictor(model), env, options={"start": start},
-                      record_states=True)
+    s0 = u.model.start_state({1: start[0], 3: start[1]})
+    ep = play_episode(agent_predictor(model), env, options={"start": s0}, record_states=True)
     refs = ReferenceGaits()
     a = audit_moves(u.model, ep["states"], 360.0, lambda s: refs.to_go(u.model, s, 360.0))
-    assert ep["success"] and (ep["regrasps"], a["to_go_start"]) == (21, 19)
-    assert (a["losing_regrasps"], a["excess_of_losing_regrasps"], a["idle_regrasps"]) == (1, 2, 0)
-    assert (a["first_loss"]["to_go_before"], a["first_loss"]["to_go_after"]) == (18, 19)
-    assert a["first_loss"]["kind"] == "regrasp" and len(ep["states"]) == ep["path_length"] + 1
+    rule = rule_based(u.model, s0, 360.0)
+    assert ep["success"] and a["to_go_start"] == 19 and rule.success
+    assert ep["regrasps"] <= rule.regrasps
+    assert (ep["regrasps"], a["excess_regrasps"], a["first_loss"]) == (19, 0, None)
+    assert len(ep["states"]) == ep["path_length"] + 1
 
 
 def test_evaluate_with_the_audit_plays_the_same_episodes(smoke_run, capsys):

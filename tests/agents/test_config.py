@@ -91,8 +91,7 @@ def test_torch_threads_follow_the_machine():
     assert TrainConfig(torch_threads=3).torch_threads == 3
 
 
-@pytest.mark.parametrize("name", ["circle", "ellipse", "pentagon", "hexagon_explore", "hexagon",
-                                  "random"])
+@pytest.mark.parametrize("name", ["circle", "ellipse", "pentagon", "hexagon", "random"])
 def test_each_shipped_model_card_holds_its_bundled_config(name):
     """`graspgait train NAME` trains the shipped model's config: the bundled YAML and the
     config in `agents/models/NAME.json` make the same TrainConfig (a field added after
@@ -109,17 +108,15 @@ def test_each_shipped_model_card_holds_its_bundled_config(name):
     assert shipped["env_kwargs"] == shipped["config"]["env_kwargs"]
 
 
-def test_the_shipped_hexagon_states_its_first_stage():
-    """The hexagon is trained in two stages; its card's ``init`` is the shipped first
-    stage's training, so the card states the whole training."""
+def test_the_shipped_hexagon_is_one_stage_with_the_regrasp_scorer():
+    """The hexagon is trained in one run (no ``init``) with the shared regrasp scorer."""
     import json
 
-    from agents.card import shipped_models_dir
+    from agents.card import load_agent, shipped_models_dir
+    from agents.policies import MaskableRegraspScorerPolicy
 
-    folder = shipped_models_dir()
-    second = json.loads((folder / "hexagon.json").read_text(encoding="utf-8"))
-    first = json.loads((folder / "hexagon_explore.json").read_text(encoding="utf-8"))
-    assert second["config"]["init_model"] == "hexagon_explore"
-    assert second["init"] == {"model": "hexagon_explore", "steps": first["steps"],
-                              "wall_s": first["wall_s"]}
-    assert first["config"]["init_model"] is None and "init" not in first
+    card = json.loads((shipped_models_dir() / "hexagon.json").read_text(encoding="utf-8"))
+    assert card["config"]["init_model"] is None and "init" not in card
+    assert card["config"]["policy"] == "agents.policies:MaskableRegraspScorerPolicy"
+    model, _ = load_agent(shipped_models_dir() / "hexagon.zip")
+    assert isinstance(model.policy, MaskableRegraspScorerPolicy)

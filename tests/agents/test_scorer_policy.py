@@ -1,0 +1,173 @@
+"""The shared regrasp scorer: its per-regrasp block, its logits, save/load, config errors."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+from agents.card import load_agent, save_agent
+from agents.config import TrainConfig, load_train_config
+from agents.policies import REGRASP_CHANNELS, GraspMapExtractor, MaskableRegraspScorerPolicy
+from agents.train import build_model, init_from_model, make_vec_env_for
+from graspgait_env.errors import GraspGaitInputError
+
+_SCORER = [
+    "policy=agents.policies:MaskableRegraspScorerPolicy",
+    "features_extractor=agents.policies:GraspMapExtractor",
+    "features_extractor_kwargs={cells: 36, conv: false, turn_steps: 180, rotations: 45, "
+    "workspace_widths: [46, 46, 46]}",
+]
+
+
+def _env(**kw):
+    return gym.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7, **kw)
+
+
+def _scorer_model(tmp_path, *more):
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_SCORER, *more])
+    return cfg, build_model(cfg, make_vec_env_for(cfg))
+
+
+@pytest.mark.parametrize("turn_deg", [360.0, -360.0])
+def test_regrasp_block_is_what_each_regrasp_does_in_the_gait_model(turn_deg):
+    env = _env(turn_deg=turn_deg)
+    u = env.unwrapped
+    m = u.model
+    K, R = m.turn_steps(turn_deg), int(m.R)
+    widths = [int(w) for w in m._widths]
+    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
+                            rotations=R, workspace_widths=widths, regrasp_block=True)
+    n_reg = env.action_space.n - 2 * R
+    assert ext.regrasp_actions == (2 * R, n_reg)
+    assert ext.features_dim == ext.block_start + n_reg * REGRASP_CHANNELS
+    rng = np.random.default_rng(5)
+    obs, info = env.reset(seed=1)
+    met = 0
+    for _ in range(150):
+        mask, s = info["action_mask"], u.state
+        block = ext.regrasp_block(torch.as_tensor(obs[None]))[0].numpy()
+        flat = ext(torch.as_tensor(obs[None]))[0, ext.block_start:].numpy()
+        np.testing.assert_array_equal(flat, block.reshape(-1))
+        legal = mask[2 * R:]
+        np.testing.assert_array_equal(block[:, 0], legal.astype(np.float32))
+        goal = np.zeros(n_reg)
+        for j in np.flatnonzero(legal):
+            t = m.apply(s, int(2 * R + j))
+            f, g = t.held()
+            pf, pg = int(m.position(f, t.contacts[f], t.k)), int(m.position(g, t.contacts[g], t.k))
+            ccw, cw = m.rotation_room(f, pf, g, pg)
+            goal[j], back = (ccw, cw) if K > 0 else (cw, ccw)
+            new = [i for i in (f, g) if s.contacts[i] < 0][0]  # the finger just placed
+            kept = g if new == f else f
+            q, l = divmod(int(j), 2)
+            assert int(m.position(new, t.contacts[new], t.k)) == q
+            np.testing.assert_allclose(block[j, 1:6],
+                                       [goal[j] / R, back / R, q / (widths[new] - 1),
+                                        (pg if kept == g else pf) / (widths[kept] - 1), l],
+                                       atol=1e-6, err_msg=f"regrasp {j} in {s}")
+            below = q > 0 and legal[2 * (q - 1) + l]
+            above = 2 * (q + 1) + l < n_reg and legal[2 * (q + 1) + l]
+            assert (block[j, 6], block[j, 7]) == (float(below), float(above))
+            met += 1
+        best = (goal == goal.max()) & (goal.max() > 0)
+        np.testing.assert_array_equal(block[:, 8], best.astype(np.float32))
+        a = int(rng.choice(np.flatnonzero(mask)))
+        obs, _, term, trunc, info = env.step(np.int64(a))
+        if term or trunc:
+            obs, info = env.reset()
+    assert met >= 100  # many legal regrasps checked
+
+
+def test_regrasp_block_needs_the_forward_gait_inputs():
+    env = _env()
+    with pytest.raises(GraspGaitInputError, match="regrasp_block=True: needs workspace_widths"):
+        GraspMapExtractor(env.observation_space, regrasp_block=True)
+
+
+def test_logits_are_the_linear_head_plus_one_shared_score_per_regrasp(tmp_path):
+    _, model = _scorer_model(tmp_path)
+    policy = model.policy
+    assert isinstance(policy, MaskableRegraspScorerPolicy)
+    ext, mlp, head = policy.features_extractor, policy.mlp_extractor, policy.action_net
+    first, count = ext.regrasp_actions
+    env = _env()
+    obs, _ = env.reset(seed=2)
+    x = torch.as_tensor(obs[None])
+    with torch.no_grad():
+        for p in mlp.scorer.parameters():  # a scorer whose output differs between rows
+            p.normal_(0.0, 0.5)
+        features = ext(x)
+        logits = head(mlp.forward_actor(features))
+        latent = mlp.mlp.forward_actor(features[:, :ext.block_start])
+        block = ext.regrasp_block(x)[0]
+        context = mlp.context(latent)[0]
+        scores = torch.stack([mlp.scorer(torch.cat((row, context))) for row in block])[:, 0]
+        linear = head.linear(latent)[0]
+    np.testing.assert_allclose(logits[0, :first].numpy(), linear[:first].numpy(), atol=1e-6)
+    np.testing.assert_allclose(logits[0, first:first + count].numpy(),
+                               (linear[first:first + count] + scores).numpy(), atol=1e-5)
+    assert float(scores.std()) > 1e-3  # the scores are not a constant the test would miss
+    # the same scorer for every regrasp: two regrasps whose block rows agree score alike
+    with torch.no_grad():
+        f2 = features.clone()
+        rows = f2[0, ext.block_start:].view(count, REGRASP_CHANNELS)
+        rows[7] = rows[3]
+        out = head(mlp.forward_actor(f2))[0] - head.linear(latent)[0]
+    assert float(out[first + 7]) == pytest.approx(float(out[first + 3]), abs=1e-6)
+
+
+def test_scorer_model_trains_saves_and_loads_with_identical_actions(tmp_path):
+    cfg, model = _scorer_model(tmp_path)
+    before = [p.detach().clone() for p in model.policy.mlp_extractor.scorer.parameters()]
+    model.learn(128)
+    after = list(model.policy.mlp_extractor.scorer.parameters())
+    assert any(not torch.equal(a, b) for a, b in zip(after, before, strict=True))  # it learns
+    path = save_agent(model, tmp_path / "m.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
+    loaded, card = load_agent(path)
+    assert card["algo"] == "maskable_ppo"
+    assert isinstance(loaded.policy, MaskableRegraspScorerPolicy)
+    assert loaded.policy.scorer_arch == [32] and loaded.policy.scorer_context == 16
+    for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
+        assert torch.equal(p, q)
+    env = _env()
+    obs, info = env.reset(seed=3)
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        mask = info["action_mask"]
+        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
+        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
+        assert int(a0) == int(a1) and mask[int(a1)]
+        obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
+        if term or trunc:
+            obs, info = env.reset()
+
+
+def test_init_logit_scale_scales_every_logit_scores_included(tmp_path):
+    cfg, model = _scorer_model(tmp_path)
+    with torch.no_grad():
+        for p in model.policy.mlp_extractor.scorer.parameters():
+            p.normal_(0.0, 0.5)
+    path = save_agent(model, tmp_path / "src.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
+    cfg2, fresh = _scorer_model(tmp_path, f"init_model={path}", "init_logit_scale=0.25")
+    init_from_model(fresh, cfg2)
+    obs, _ = _env().reset(seed=4)
+    x = torch.as_tensor(obs[None])
+    with torch.no_grad():
+        def logits(m):
+            pol = m.policy
+            return pol.action_net(pol.mlp_extractor.forward_actor(pol.extract_features(x)))
+        np.testing.assert_allclose(logits(fresh).numpy(), 0.25 * logits(model).numpy(),
+                                   rtol=1e-5, atol=1e-6)
+
+
+def test_scorer_policy_needs_maskable_ppo_and_the_extractor(tmp_path):
+    with pytest.raises(GraspGaitInputError, match="needs algo: maskable_ppo"):
+        TrainConfig(name="x", algo="ppo", policy="agents.policies:MaskableRegraspScorerPolicy")
+    with pytest.raises(GraspGaitInputError, match="policy='MlpPolicy2'"):
+        TrainConfig(name="x", policy="MlpPolicy2")
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", _SCORER[0]])
+    with pytest.raises(GraspGaitInputError, match="needs agents.policies:GraspMapExtractor"):
+        build_model(cfg, make_vec_env_for(cfg))
