@@ -121,6 +121,13 @@ def layout_of(observation_space: gym.spaces.Box, cells: int, line_cells: int,
     return ObservationLayout(n_actions, cells, line_cells)
 
 
+def _most_room(room: torch.Tensor) -> torch.Tensor:
+    """``(batch, 2 W)``: 1 for the regrasps whose room (0 where illegal) is the most, all 0
+    when none leaves any (thesis 6.3.1's choice)."""
+    most = room.amax(dim=1, keepdim=True)
+    return ((room == most) & (most > 0)).to(room.dtype)
+
+
 class GraspMapExtractor(BaseFeaturesExtractor):
     """Header and mask as they are, a CNN over the grasp-map window, a 1-D CNN over the lines.
 
@@ -348,10 +355,8 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         below = torch.cat((zero, by_q[:, :-1]), dim=1).reshape(b, -1)
         above = torch.cat((by_q[:, 1:], zero), dim=1).reshape(b, -1)
         goal = geo["goal"]
-        most = goal.amax(dim=1, keepdim=True)
-        best = ((goal == most) & (most > 0)).to(goal.dtype) * legal
         return torch.stack((legal, goal / R, geo["back"] / R, geo["q"], geo["kept"], geo["l"],
-                            below, above, best), dim=2)
+                            below, above, _most_room(goal)), dim=2)
 
     def forward_gait_features(self, observations: torch.Tensor,
                               geometry: dict[str, torch.Tensor] | None = None) -> torch.Tensor:
@@ -368,9 +373,7 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         room = geo["goal"] / self.rotations
         if not self.best_regrasp:
             return torch.cat((longest, room), dim=1)
-        most = room.amax(dim=1, keepdim=True)
-        best = ((room == most) & (most > 0)).to(room.dtype)
-        return torch.cat((longest, room, best), dim=1)
+        return torch.cat((longest, room, _most_room(room)), dim=1)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         """Features of a batch of observations, shape ``(batch, features_dim)``."""

@@ -17,3 +17,4 @@ def smoke_run(tmp_path_factory):
     root = tmp_path_factory.mktemp("runs")
     config = load_train_config("smoke", [f"run_root={root}"])
     return train(config, progress=False)
+

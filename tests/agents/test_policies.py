@@ -12,6 +12,7 @@ from agents.config import load_train_config
 from agents.policies import GraspMapExtractor, layout_of
 from agents.train import build_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
+from tests.agents.helpers import assert_same_greedy_actions
 
 _EXTRACTOR = "agents.policies:GraspMapExtractor"
 
@@ -79,16 +80,7 @@ def test_model_with_the_extractor_saves_and_loads_with_identical_actions(tmp_pat
     loaded, _ = load_agent(path)
     assert isinstance(loaded.policy.features_extractor, GraspMapExtractor)
     env = _env(map_lines=True, map_window_cells=12)
-    obs, info = env.reset(seed=3)
-    rng = np.random.default_rng(0)
-    for _ in range(20):
-        mask = info["action_mask"]
-        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
-        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
-        assert int(a0) == int(a1) and mask[int(a1)]
-        obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
-        if term or trunc:
-            obs, info = env.reset()
+    assert_same_greedy_actions(model, loaded, env)
     for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
         assert torch.equal(p, q)
 

@@ -12,6 +12,7 @@ from agents.config import TrainConfig, load_train_config
 from agents.policies import REGRASP_CHANNELS, GraspMapExtractor, MaskableRegraspScorerPolicy
 from agents.train import build_model, init_from_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
+from tests.agents.helpers import assert_same_greedy_actions
 
 _SCORER = [
     "policy=agents.policies:MaskableRegraspScorerPolicy",
@@ -133,16 +134,7 @@ def test_scorer_model_trains_saves_and_loads_with_identical_actions(tmp_path):
     for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
         assert torch.equal(p, q)
     env = _env()
-    obs, info = env.reset(seed=3)
-    rng = np.random.default_rng(0)
-    for _ in range(20):
-        mask = info["action_mask"]
-        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
-        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
-        assert int(a0) == int(a1) and mask[int(a1)]
-        obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
-        if term or trunc:
-            obs, info = env.reset()
+    assert_same_greedy_actions(model, loaded, env)
 
 
 def test_init_logit_scale_scales_every_logit_scores_included(tmp_path):

@@ -1,0 +1,20 @@
+"""Helpers shared by the agent tests."""
+
+from __future__ import annotations
+
+
+def assert_same_greedy_actions(model, loaded, env, steps: int = 20, seed: int = 3) -> None:
+    """``model`` and ``loaded`` pick the same legal deterministic action at each of
+    ``steps`` states of ``env``, visited by random legal moves."""
+    import numpy as np
+
+    obs, info = env.reset(seed=seed)
+    rng = np.random.default_rng(0)
+    for _ in range(steps):
+        mask = info["action_mask"]
+        a0, _ = model.predict(obs, deterministic=True, action_masks=mask)
+        a1, _ = loaded.predict(obs, deterministic=True, action_masks=mask)
+        assert int(a0) == int(a1) and mask[int(a1)]
+        obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
+        if term or trunc:
+            obs, info = env.reset()
