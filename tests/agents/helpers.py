@@ -18,3 +18,17 @@ def assert_same_greedy_actions(model, loaded, env, steps: int = 20, seed: int = 
         obs, _, term, trunc, info = env.step(np.int64(rng.choice(np.flatnonzero(mask))))
         if term or trunc:
             obs, info = env.reset()
+
+
+def gait_extractor(env, turn_deg: float, **flags):
+    """A 36-cell, convolution-free ``GraspMapExtractor`` for ``env`` with the gait inputs
+    read from its ``GaitModel`` (``turn_steps``, ``rotations``, ``workspace_widths``) and
+    ``flags`` on top. Returns ``(extractor, model, turn_steps, rotations, widths)``."""
+    from agents.policies import GraspMapExtractor
+
+    m = env.unwrapped.model
+    K, R = m.turn_steps(turn_deg), int(m.R)
+    widths = [int(w) for w in m._widths]
+    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
+                            rotations=R, workspace_widths=widths, **flags)
+    return ext, m, K, R, widths

@@ -12,7 +12,7 @@ from agents.config import load_train_config
 from agents.policies import GraspMapExtractor, layout_of
 from agents.train import build_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
-from tests.agents.helpers import assert_same_greedy_actions
+from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
 _EXTRACTOR = "agents.policies:GraspMapExtractor"
 
@@ -160,13 +160,8 @@ def test_forward_gait_features_are_the_longest_rotation_and_the_room_after_each_
         turn_deg):
     env = _env(turn_deg=turn_deg)
     u = env.unwrapped
-    m = u.model
-    K, R = m.turn_steps(turn_deg), int(m.R)
-    widths = [int(w) for w in m._widths]
-    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
-                            rotations=R, workspace_widths=widths, best_regrasp=True)
-    plain = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
-                              rotations=R, workspace_widths=widths)
+    ext, m, K, R, _ = gait_extractor(env, turn_deg, best_regrasp=True)
+    plain = gait_extractor(env, turn_deg)[0]
     n_reg = env.action_space.n - 2 * R
     assert ext.features_dim == env.observation_space.shape[0] + R + R + 2 * n_reg
     rng = np.random.default_rng(3)

@@ -12,7 +12,7 @@ from agents.config import TrainConfig, load_train_config
 from agents.policies import REGRASP_CHANNELS, GraspMapExtractor, MaskableRegraspScorerPolicy
 from agents.train import build_model, init_from_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
-from tests.agents.helpers import assert_same_greedy_actions
+from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
 _SCORER = [
     "policy=agents.policies:MaskableRegraspScorerPolicy",
@@ -36,11 +36,7 @@ def _scorer_model(tmp_path, *more):
 def test_regrasp_block_is_what_each_regrasp_does_in_the_gait_model(turn_deg):
     env = _env(turn_deg=turn_deg)
     u = env.unwrapped
-    m = u.model
-    K, R = m.turn_steps(turn_deg), int(m.R)
-    widths = [int(w) for w in m._widths]
-    ext = GraspMapExtractor(env.observation_space, cells=36, conv=False, turn_steps=K,
-                            rotations=R, workspace_widths=widths, regrasp_block=True)
+    ext, m, K, R, widths = gait_extractor(env, turn_deg, regrasp_block=True)
     n_reg = env.action_space.n - 2 * R
     assert ext.regrasp_actions == (2 * R, n_reg)
     assert ext.features_dim == ext.block_start + n_reg * REGRASP_CHANNELS
