@@ -122,7 +122,12 @@ def test_sweep_writes_png(tmp_path, capsys):
     assert png.read_bytes()[:8] == PNG_MAGIC
 
 
-def test_perf_prints_ratio_and_json(tmp_path, capsys):
+def test_perf_prints_ratio_and_json(tmp_path, capsys, monkeypatch):
+    """The CLI wiring, on the grasp-map rows only (the full run is the slow test below)."""
+    import graspgait_env.perf as perf
+
+    monkeypatch.setattr(perf, "BENCHMARK_MODULES", [])
+    monkeypatch.setattr(perf, "BENCHMARKS", [perf.bench_grasp_map])
     js = tmp_path / "perf.json"
     assert main(["perf", "--repeat", "2", "--json", str(js)]) == 0
     out = capsys.readouterr().out
@@ -132,6 +137,17 @@ def test_perf_prints_ratio_and_json(tmp_path, capsys):
     doc = json.loads(js.read_text())
     names = [r["name"] for r in doc["rows"]]
     assert "speed-up vs loop" in names
+    assert all(r["verdict"] in ("PASS", "FAIL", "-") for r in doc["rows"])
+    assert len(names) == 3  # the grasp map, its loop, the ratio: nothing else ran
+
+
+@pytest.mark.slow
+def test_perf_runs_every_registered_benchmark(tmp_path, capsys):
+    js = tmp_path / "perf.json"
+    assert main(["perf", "--repeat", "2", "--json", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    names = [r["name"] for r in doc["rows"]]
+    assert len(names) > 3 and "speed-up vs loop" in names
     assert all(r["verdict"] in ("PASS", "FAIL", "-") for r in doc["rows"])
 
 
