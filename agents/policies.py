@@ -57,6 +57,12 @@ for each regrasp action, :data:`REGRASP_CHANNELS` entries computed from the obse
 (:meth:`GraspMapExtractor.regrasp_block`), which that policy's shared scorer reads, one
 regrasp at a time; they follow every other feature and the policy keeps them out of
 its MLPs.
+The **action block** (``reach_depth``, with the regrasp block): the block then covers
+every action, rotations included, and adds to each action's entries the env's reach
+look-ahead (``regrasp_lookahead``: how far short of the turn the best chain of a few
+more regrasps after that move stays, a depth-limited search of the grasp map), so the
+shared scorer prices every move by what it leads to (:meth:`GraspMapExtractor.
+action_block`).
 Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
 through unchanged too. The features are the concatenation (header and mask, window
 features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
@@ -85,6 +91,7 @@ __all__ = ["REGRASP_CHANNELS", "GraspMapExtractor", "MaskableRegraspScorerPolicy
 
 REGRASP_CHANNELS = 9
 """Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
+_ACTION_CHANNELS = 3  # with reach_depth: legal, is a rotation, the rotation's steps
 
 _HEADER = 16  # ObservationLayout's header: held, positions, contact and object angles, turn
 
@@ -157,6 +164,15 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         With ``workspace_widths``: append :meth:`regrasp_block`, flattened (``2 W x``
         :data:`REGRASP_CHANNELS` entries, after every other feature), for
         :class:`MaskableRegraspScorerPolicy`, which sets it and reads the block apart.
+    reach_depth
+        The env's ``regrasp_lookahead`` ``D`` (its field is the last ``A x D`` entries,
+        counted in ``tail``), with the regrasp block: the scored block then covers
+        every action, :meth:`action_block` (the rotations are scored by the same
+        network). 0 (default): the regrasp block alone.
+    reach_relative, reach_best
+        With ``reach_depth``: add to each action's block the field less its least over
+        the legal moves, and a one-hot of the legal moves with that least, per depth
+        (see :meth:`action_block`).
     turn_steps
         The requested turn in grid steps, signed (``turn_deg / (360 / n)``: 180 for the
         default 360° at ``n = 180``); with ``rotations``, adds the finishing rotations.
@@ -177,6 +193,8 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                  tail: int = 0, conv: bool = True, turn_steps: int = 0, rotations: int = 0,
                  shortfall_bins: int = 0, workspace_widths: Sequence[int] | None = None,
                  best_regrasp: bool = False, regrasp_block: bool = False,
+                 reach_depth: int = 0, reach_relative: bool = False,
+                 reach_best: bool = False,
                  window_channels: Sequence[int] = (8, 16),
                  line_channels: Sequence[int] = (8, 16),
                  window_features: int = 64, line_features: int = 64) -> None:
@@ -220,14 +238,30 @@ class GraspMapExtractor(BaseFeaturesExtractor):
                 "features_extractor_kwargs regrasp_block=True: needs workspace_widths, "
                 "turn_steps and rotations (the block is computed from them), e.g. "
                 "workspace_widths: [46, 46, 46], turn_steps: 180, rotations: 45")
-        n_block = n_regrasp * REGRASP_CHANNELS if regrasp_block else 0
+        self.reach_depth = int(reach_depth)
+        if self.reach_depth:
+            n_reach = n_actions * self.reach_depth
+            if not regrasp_block or self.reach_depth < 0 or n_reach > int(tail):
+                raise GraspGaitInputError(
+                    f"features_extractor_kwargs reach_depth={reach_depth!r}: the env's "
+                    "regrasp_lookahead (its last n_actions x D entries, inside tail), with "
+                    "policy MaskableRegraspScorerPolicy; e.g. reach_depth: 3, tail: 546")
+        #: entries per action in the scored block (regrasps only, or every action)
+        self.reach_relative = bool(reach_relative) and self.reach_depth > 0
+        self.reach_best = bool(reach_best) and self.reach_depth > 0
+        self.block_channels = (REGRASP_CHANNELS + _ACTION_CHANNELS
+                               + self.reach_depth * (1 + self.reach_relative + self.reach_best)
+                               if self.reach_depth else REGRASP_CHANNELS)
+        n_scored = n_actions if self.reach_depth else (n_regrasp if regrasp_block else 0)
+        n_block = n_scored * self.block_channels if regrasp_block else 0
         super().__init__(observation_space,
                          width + int(tail) + (int(rotations) if finishing else 0)
                          + self.shortfall_bins + n_forward + n_block)
         self.with_block = bool(regrasp_block)
         #: where the regrasp actions lie in the action space (first index, count) and
         #: how many features precede the regrasp block (with ``regrasp_block``)
-        self.regrasp_actions = ((2 * int(rotations), n_block // REGRASP_CHANNELS)
+        self.regrasp_actions = (((0, n_actions) if self.reach_depth
+                                 else (2 * int(rotations), n_block // REGRASP_CHANNELS))
                                 if regrasp_block else (0, 0))
         self.block_start = self.features_dim - n_block
         self.gait_features = widths is not None
@@ -397,8 +431,56 @@ class GraspMapExtractor(BaseFeaturesExtractor):
             geo = self._regrasp_geometry(observations)  # once for both users
             parts.append(self.forward_gait_features(observations, geo))
         if self.with_block:
-            parts.append(self.regrasp_block(observations, geo).reshape(b, -1))
+            block = self.regrasp_block(observations, geo)
+            if self.reach_depth:
+                block = self.action_block(observations, block)
+            parts.append(block.reshape(b, -1))
         return torch.cat(parts, dim=1)
+
+    def action_block(self, observations: torch.Tensor, regrasp_block: torch.Tensor
+                     ) -> torch.Tensor:
+        """``(batch, A, block_channels)`` with ``reach_depth``: every action's entries for
+        the shared scorer. Per action: the :meth:`regrasp_block` channels (0 for a
+        rotation); legal (the mask); 1 for a rotation; the rotation's grid steps over
+        ``R``, positive towards the goal (0 for a regrasp); then the env's reach
+        look-ahead, ``reach_depth`` entries (the shortfall of the turn after ``j = 0 ..
+        D - 1`` more regrasps, over the turn; see ``GraspGait-v0``'s *Observation
+        Space*), read from the observation's last ``A x D`` entries; with
+        ``reach_relative``, ``D`` more: each of those less its least over the legal
+        moves (0 for an illegal move), so that the best moves read 0 whatever the
+        state; with ``reach_best``, ``D`` more: 1 for the legal moves with that least
+        (a one-hot of the best moves per depth, as ``best_regrasp`` is for the rotation
+        room: one grid step is 1/180 of the turn, a difference a network reads poorly)."""
+        lay, R, D = self.layout, self.rotations, self.reach_depth
+        b = observations.shape[0]
+        A = lay.mask.stop - lay.mask.start
+        n_reg = A - 2 * R
+        end = lay.size + self.tail
+        reach = observations[:, end - A * D:end]
+        per_regrasp = reach[:, :n_reg * D].reshape(b, n_reg, D)
+        per_rotation = reach[:, n_reg * D:].reshape(b, 2 * R, D)
+        legal = observations[:, lay.mask]
+        steps = self._steps / R
+        towards = steps if self.turn_steps > 0 else -steps
+        signed = torch.cat((towards, -towards))  # CCW first, then CW (the action layout)
+        rot = torch.zeros(b, 2 * R, REGRASP_CHANNELS, dtype=observations.dtype,
+                          device=observations.device)
+        kind = torch.cat((torch.ones(2 * R), torch.zeros(n_reg))).to(observations)
+        step_col = torch.cat((signed, torch.zeros(n_reg, device=signed.device))).to(observations)
+        base = torch.cat((rot, regrasp_block), dim=1)
+        extra = torch.stack((legal, kind.expand(b, -1), step_col.expand(b, -1)), dim=2)
+        field = torch.cat((per_rotation, per_regrasp), dim=1)  # [batch, A, D]
+        parts = [base, extra, field]
+        if self.reach_relative or self.reach_best:
+            big = torch.finfo(field.dtype).max
+            least = torch.where(legal[:, :, None] > 0, field, big).amin(dim=1, keepdim=True)
+            least = torch.where(least == big, torch.zeros_like(least), least)
+            above = (field - least) * legal[:, :, None]
+        if self.reach_relative:  # each entry less the least over the legal moves
+            parts.append(above)
+        if self.reach_best:  # 1 for the legal moves with the least, per depth
+            parts.append(((above <= 1e-6) & (legal[:, :, None] > 0)).to(field.dtype))
+        return torch.cat(parts, dim=2)
 
 
 class _ScorerExtractor(nn.Module):
@@ -408,14 +490,16 @@ class _ScorerExtractor(nn.Module):
     ``forward_actor`` returns ``[policy latent, one score per regrasp action]``."""
 
     def __init__(self, base_dim: int, n_regrasp: int, net_arch: Any, activation_fn: type,
-                 scorer_arch: Sequence[int], context: int, device: Any) -> None:
+                 scorer_arch: Sequence[int], context: int, device: Any,
+                 channels: int = REGRASP_CHANNELS) -> None:
         super().__init__()
         self.mlp = MlpExtractor(base_dim, net_arch=net_arch, activation_fn=activation_fn,
                                 device=device)
         self.base_dim, self.n_regrasp = int(base_dim), int(n_regrasp)
         self.context = nn.Sequential(nn.Linear(self.mlp.latent_dim_pi, int(context)), nn.ReLU())
         layers: list[nn.Module] = []
-        c_in = REGRASP_CHANNELS + int(context)
+        self.channels = int(channels)
+        c_in = self.channels + int(context)
         for width in scorer_arch:
             layers += [nn.Linear(c_in, int(width)), nn.ReLU()]
             c_in = int(width)
@@ -430,7 +514,7 @@ class _ScorerExtractor(nn.Module):
     def forward_actor(self, features: torch.Tensor) -> torch.Tensor:
         b = features.shape[0]
         latent = self.mlp.forward_actor(features[:, :self.base_dim])
-        block = features[:, self.base_dim:].reshape(b, self.n_regrasp, REGRASP_CHANNELS)
+        block = features[:, self.base_dim:].reshape(b, self.n_regrasp, self.channels)
         context = self.context(latent)[:, None, :].expand(-1, self.n_regrasp, -1)
         scores = self.scorer(torch.cat((block, context), dim=2)).squeeze(2)
         return torch.cat((latent, scores), dim=1)
@@ -475,6 +559,9 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     regrasps are legal, whether it has the most room) and a ``scorer_context``-wide
     ReLU projection of the policy latent (what the state asks for). The value head is
     SB3's.
+    With the extractor's ``reach_depth`` every action, rotations included, is scored
+    the same way from :meth:`GraspMapExtractor.action_block` (its regrasp entries, the
+    rotation's size and direction, and the env's reach look-ahead of that move).
 
     Why: with a flat head every regrasp action has its own output weights, so what the
     agent learns of a regrasp at one workspace position (e.g. that one leaving no
@@ -521,7 +608,8 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
         fx = self.features_extractor
         self.mlp_extractor = _ScorerExtractor(fx.block_start, fx.regrasp_actions[1],
                                               self.net_arch, self.activation_fn,
-                                              self.scorer_arch, self.scorer_context, self.device)
+                                              self.scorer_arch, self.scorer_context, self.device,
+                                              fx.block_channels)
 
     def _build(self, lr_schedule: Any) -> None:
         super()._build(lr_schedule)

@@ -246,6 +246,15 @@ class GraspGaitConfig:
     (``2 R`` entries, 1: the rotation opens at least one regrasp; a one-step look-ahead
     of the legal-move function of thesis 4.2 and 5.2, not the optimum's regrasps to go;
     see the env's *Observation Space*). False (the default): no look-ahead."""
+    regrasp_lookahead: int = 0
+    """Append the **reach look-ahead** ``D`` regrasps deep (an integer ``0 ..``
+    :data:`~graspgait_env.planners.reach.MAX_REACH_DEPTH` ``+ 1``; 0, the default: none;
+    beyond the thesis): for each regrasp action, how far short of the turn the grasp it
+    makes stays after the best chain of ``j`` more regrasps, ``j = 0 .. D - 1``; for
+    each rotation action, the least of those (``j = D - 1``) over the regrasps legal
+    after it (``2 P D + 2 R`` entries; a depth-limited search of the grasp map,
+    :class:`~graspgait_env.planners.reach.RegraspReach`, not the optimum's regrasps to
+    go; see the env's *Observation Space*)."""
     forbid_reversal: bool = False
     """After a rotation, make the rotations the other way illegal until the next regrasp
     (True; beyond the thesis), so that a policy cannot rock the object back and forth
@@ -306,6 +315,14 @@ class GraspGaitConfig:
             raise GraspGaitInputError(
                 f"rotation_lookahead={self.rotation_lookahead!r}: must be True or False")
         put("rotation_lookahead", bool(self.rotation_lookahead))
+        from graspgait_env.planners.reach import MAX_REACH_DEPTH
+
+        depth = check_count("regrasp_lookahead", self.regrasp_lookahead, 0, 3)
+        if depth > MAX_REACH_DEPTH + 1:
+            raise GraspGaitInputError(
+                f"regrasp_lookahead={self.regrasp_lookahead!r}: at most {MAX_REACH_DEPTH + 1} "
+                "regrasps deep (0: off), e.g. 3")
+        put("regrasp_lookahead", depth)
         if not isinstance(self.forbid_reversal, (bool, np.bool_)):
             raise GraspGaitInputError(
                 f"forbid_reversal={self.forbid_reversal!r}: must be True or False")

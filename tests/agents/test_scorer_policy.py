@@ -159,3 +159,80 @@ def test_scorer_policy_needs_maskable_ppo_and_the_extractor(tmp_path):
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", _SCORER[0]])
     with pytest.raises(GraspGaitInputError, match="needs agents.policies:GraspMapExtractor"):
         build_model(cfg, make_vec_env_for(cfg))
+
+
+@pytest.mark.parametrize("turn_deg", [360.0, -360.0])
+def test_action_block_scores_every_action_from_the_reach_lookahead(turn_deg):
+    """With ``reach_depth`` the scored block covers every action: the regrasp channels
+    (0 for rotations), legal, is-a-rotation, the signed rotation steps and the env's
+    reach look-ahead of that action."""
+    D = 2
+    env = _env(turn_deg=turn_deg, regrasp_lookahead=D, map_lines=False)
+    u = env.unwrapped
+    A = env.action_space.n
+    ext, m, K, R, widths = gait_extractor(env, turn_deg, regrasp_block=True, reach_depth=D,
+                                          tail=A * D)
+    n_reg = A - 2 * R
+    C = ext.block_channels
+    assert C == REGRASP_CHANNELS + 3 + D and ext.regrasp_actions == (0, A)
+    assert ext.features_dim == ext.block_start + A * C
+    obs, info = env.reset(seed=2)
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        x = torch.as_tensor(obs[None])
+        block = ext(x)[0, ext.block_start:].numpy().reshape(A, C)
+        regrasp = ext.regrasp_block(x)[0].numpy()
+        np.testing.assert_array_equal(block[2 * R:, :REGRASP_CHANNELS], regrasp)
+        assert not block[:2 * R, :REGRASP_CHANNELS].any()
+        np.testing.assert_array_equal(block[:, REGRASP_CHANNELS], info["action_mask"])
+        np.testing.assert_array_equal(block[:, REGRASP_CHANNELS + 1], np.arange(A) < 2 * R)
+        steps = np.concatenate((np.arange(1, R + 1), -np.arange(1, R + 1))) / R
+        np.testing.assert_allclose(block[:2 * R, REGRASP_CHANNELS + 2],
+                                   steps if K > 0 else -steps, rtol=1e-6)
+        field = obs[u.layout.reach]
+        np.testing.assert_array_equal(block[2 * R:, -D:], field[:n_reg * D].reshape(n_reg, D))
+        np.testing.assert_array_equal(block[:2 * R, -D:], field[n_reg * D:].reshape(2 * R, D))
+        obs, _, term, trunc, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
+        if term or trunc:
+            break
+
+
+def test_reach_depth_needs_the_field_and_the_block():
+    env = _env(regrasp_lookahead=2)
+    A = env.action_space.n
+    with pytest.raises(GraspGaitInputError, match="reach_depth"):
+        gait_extractor(env, 360.0, reach_depth=2, tail=A * 2)  # no regrasp block
+    with pytest.raises(GraspGaitInputError, match="reach_depth"):
+        gait_extractor(env, 360.0, regrasp_block=True, reach_depth=3, tail=A * 2)  # deeper
+
+
+def test_reach_relative_channels_are_each_entry_less_the_best_legal_one():
+    D = 2
+    env = _env(regrasp_lookahead=D, map_lines=False)
+    A = env.action_space.n
+    ext, m, K, R, widths = gait_extractor(env, 360.0, regrasp_block=True, reach_depth=D,
+                                          reach_relative=True, tail=A * D)
+    C = ext.block_channels
+    assert C == REGRASP_CHANNELS + 3 + 2 * D
+    obs, info = env.reset(seed=4)
+    block = ext(torch.as_tensor(obs[None]))[0, ext.block_start:].numpy().reshape(A, C)
+    field, rel = block[:, -2 * D:-D], block[:, -D:]
+    legal = info["action_mask"]
+    np.testing.assert_allclose(rel[legal], field[legal] - field[legal].min(axis=0), atol=1e-6)
+    assert not rel[~legal].any() and (rel[legal] == 0).any()
+
+
+def test_reach_best_channels_mark_the_legal_moves_with_the_least():
+    D = 2
+    env = _env(regrasp_lookahead=D, map_lines=False)
+    A = env.action_space.n
+    ext, *_ = gait_extractor(env, 360.0, regrasp_block=True, reach_depth=D, reach_best=True,
+                             tail=A * D)
+    assert ext.block_channels == REGRASP_CHANNELS + 3 + 2 * D
+    obs, info = env.reset(seed=4)
+    block = ext(torch.as_tensor(obs[None]))[0, ext.block_start:].numpy().reshape(A, -1)
+    field, best = block[:, -2 * D:-D], block[:, -D:]
+    legal = info["action_mask"]
+    want = legal[:, None] & np.isclose(field, field[legal].min(axis=0), atol=1e-6)
+    np.testing.assert_array_equal(best, want.astype(np.float32))
+    assert best.sum(axis=0).min() >= 1

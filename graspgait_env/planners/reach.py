@@ -1,0 +1,183 @@
+"""How far towards the turn a grasp can take the object within ``j`` more regrasps.
+
+A depth-limited version of the exact planner's search (:mod:`~graspgait_env.planners.
+exact`, beyond the thesis): on the same *segments* (a finger pair holding two fixed
+contacts, with the interval of object angles its rotations reach, thesis 5.2) the
+**reach** of a segment within ``j`` regrasps is the farthest object angle towards the
+requested turn that some chain of at most ``j`` regrasps from it, with any rotations in
+between, can turn the object to (capped at the turn). Its recursion:
+
+- ``reach_0(s)`` = the end of ``s``'s own interval towards the turn (rotation only);
+- ``reach_j(s) = max(reach_{j-1}(s), max over the segments s' one regrasp from s of
+  reach_{j-1}(s'))``.
+
+One regrasp from ``s`` keeps one of its contacts and places the free finger at any
+contact it can touch at some angle of ``s``'s interval (a contiguous run of the extended
+grasp map, thesis 4.2), so the inner max is a range maximum along a row of the extended
+map; a sparse table answers all of them at once per level. The regrasp relation is
+symmetric (both grasps share the regrasp's object angle), as in the exact planner.
+
+Why it exists: it prices a regrasp by what it leads to, a few regrasps deep, which is
+what the forward gait (thesis 6.3.1: the regrasp with the most rotation room, one
+regrasp deep) cannot see. The GraspGait envs offer it as an opt-in observation field
+(``regrasp_lookahead``). It is not the optimum: at depth ``J`` it tells whether the turn
+is reached within ``J`` more regrasps and, when not, how close the best such chain gets;
+the exact planner's count to go is the smallest ``j`` with a shortfall of 0, which for
+the procedural objects is about 9 regrasps from the start, beyond the depths offered.
+
+Search window: the exact planner's :class:`~graspgait_env.planners.exact.RegraspsToGo`
+window (object angles from ``max_backward_deg`` against the turn to the turn), so a
+segment's reach never exceeds the turn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.gait import GaitModel, GaitState
+from graspgait_env.planners.exact import PAIRS, _pair_index, _Segments
+
+__all__ = ["MAX_REACH_DEPTH", "RegraspReach"]
+
+MAX_REACH_DEPTH = 4
+"""The deepest reach table :class:`RegraspReach` builds (regrasps)."""
+
+
+def _range_max(values: NDArray[np.int64], lo: NDArray[np.int64],
+               hi: NDArray[np.int64], fill: int) -> NDArray[np.int64]:
+    """Row-wise ``max(values[r, lo[r, c] .. hi[r, c]])`` for every ``(r, c)``, ``fill``
+    where ``lo > hi`` (empty range): a sparse table over each row."""
+    L = values.shape[1]
+    tables = [values]
+    width = 1
+    while 2 * width <= L:
+        prev = tables[-1]
+        nxt = prev.copy()
+        nxt[:, : L - width] = np.maximum(prev[:, : L - width], prev[:, width:])
+        tables.append(nxt)
+        width *= 2
+    length = hi - lo + 1
+    empty = length < 1
+    # floor(log2(length)) exactly, for integers
+    lev = np.frexp(np.maximum(length, 1).astype(np.float64))[1].astype(np.int64) - 1
+    rows = np.broadcast_to(np.arange(values.shape[0])[:, None], lo.shape)
+    out = np.full(lo.shape, fill, dtype=np.int64)
+    ok = ~empty
+    r, a, b, e = rows[ok], lo[ok], hi[ok], lev[ok]
+    stack = np.stack(tables)  # (levels, rows, L)
+    left = stack[e, r, a]
+    right = stack[e, r, b - (1 << e) + 1]
+    out[ok] = np.maximum(left, right)
+    return out
+
+
+class RegraspReach:
+    """Reach tables of one gait model and turn: ``reach_j`` for ``j = 0 .. depth``.
+
+    Parameters
+    ----------
+    model
+        The gait model.
+    turn_deg
+        Requested turn (degrees; negative: clockwise).
+    max_backward_deg
+        How far against the turn the search window reaches (degrees, > 0), as
+        :class:`~graspgait_env.planners.exact.RegraspsToGo`.
+    depth
+        The deepest table (regrasps), ``0 .. MAX_REACH_DEPTH``.
+
+    Attributes
+    ----------
+    depth, turn_steps
+        As given (the turn in grid steps, signed).
+    levels
+        ``levels[j][pair]``: the reach of every extended-map point of the pair (``PAIRS``
+        order, array index ``x - x0``) within ``j`` regrasps, in grid steps *towards the
+        turn* (the object angle times the turn's sign); ``unreachable`` for points that
+        are no legal segment of the window.
+
+    Examples
+    --------
+    >>> from graspgait_env.gait import GaitModel
+    >>> from graspgait_env.planners.exact import RegraspsToGo
+    >>> model = GaitModel("ellipse", 0.7)
+    >>> start = model.start_state({1: 50.0, 3: 270.0})
+    >>> reach = RegraspReach(model, 360.0, 360.0, depth=4)
+    >>> to_go = RegraspsToGo(model, 360.0, 360.0)(start)
+    >>> [reach.shortfall(start, j) == 0 for j in range(to_go - 1, to_go + 1)]
+    [False, True]
+    """
+
+    def __init__(self, model: GaitModel, turn_deg: float = 360.0,
+                 max_backward_deg: float = 360.0, depth: int = 2) -> None:
+        if isinstance(depth, bool) or not isinstance(depth, (int, np.integer)) \
+                or not 0 <= int(depth) <= MAX_REACH_DEPTH:
+            raise GraspGaitInputError(
+                f"depth={depth!r}: the reach look-ahead is 0 .. {MAX_REACH_DEPTH} regrasps "
+                "deep; give e.g. 2")
+        K = model.turn_steps(turn_deg)
+        B = abs(model.turn_steps(max_backward_deg))
+        sign = 1 if K >= 0 else -1
+        k_lo, k_hi = (-B, K) if sign > 0 else (K, B)
+        self.model, self.turn_steps, self.depth, self._sign = model, K, int(depth), sign
+        self._seg = seg = _Segments(model, k_lo, k_hi)
+        self.unreachable = -(B + 1)  # below every angle of the window, towards the turn
+        first = [np.where(v, km if sign > 0 else -kn, self.unreachable).astype(np.int64)
+                 for v, km, kn in zip(seg.valid, seg.kmax, seg.kmin, strict=True)]
+        self.levels: list[list[NDArray[np.int64]]] = [first]
+        # per (target pair, kept finger): the range of the third finger's contact that a
+        # regrasp from the target's segment can place (the exact planner's h_interval)
+        self._ranges = []
+        for q, (a, b) in enumerate(PAIRS):
+            for keep in (a, b):
+                t = 3 - a - b
+                lo, hi = seg.h_interval(t, seg.kmin[q], seg.kmax[q])
+                # rows of the target array are `keep`: transpose when keep is its 2nd finger
+                if keep != a:
+                    lo, hi = lo.T, hi.T
+                self._ranges.append((q, keep, t, lo, hi))
+        for _ in range(self.depth):
+            self.levels.append(self._propagate(self.levels[-1]))
+
+    def _propagate(self, prev: list[NDArray[np.int64]]) -> list[NDArray[np.int64]]:
+        out = [p.copy() for p in prev]
+        fill = self.unreachable
+        for q, keep, t, lo, hi in self._ranges:
+            src = _pair_index(keep, t)
+            # source values with rows = keep's contact, columns = t's contact
+            vals = prev[src] if keep < t else prev[src].T
+            best = _range_max(vals, lo, hi, fill)  # rows keep, columns the pair's other
+            if keep != PAIRS[q][0]:
+                best = best.T
+            valid = self._seg.valid[q]
+            np.maximum(out[q], np.where(valid, best, fill), out=out[q])
+        return out
+
+    # ------------------------------------------------------------------ queries
+    def _coord(self, f: int, state: GaitState) -> int:
+        """Array index of finger ``f``'s unwrapped contact at ``state``: ``x = s + p - k``."""
+        model = self.model
+        p = model.position(f, state.contacts[f], state.k)
+        return int(model.ws_start[f] + p - state.k - self._seg.x0[f])
+
+    def reach(self, state: GaitState, j: int) -> int:
+        """Farthest object angle (grid steps, signed as the turn) that the state's segment
+        reaches within ``j`` regrasps; ``unreachable * sign`` outside the window."""
+        f, g = state.held()
+        i, jj = self._coord(f, state), self._coord(g, state)
+        table = self.levels[j][_pair_index(f, g)]
+        if not (0 <= i < table.shape[0] and 0 <= jj < table.shape[1]):
+            return self.unreachable * self._sign
+        return int(table[i, jj]) * self._sign
+
+    def shortfall(self, state: GaitState, j: int) -> int:
+        """Grid steps short of the turn after the best chain of at most ``j`` regrasps
+        from ``state`` (0: it reaches the turn)."""
+        f, g = state.held()
+        i, jj = self._coord(f, state), self._coord(g, state)
+        table = self.levels[j][_pair_index(f, g)]
+        if not (0 <= i < table.shape[0] and 0 <= jj < table.shape[1]):
+            return abs(self.turn_steps) - self.unreachable
+        return max(abs(self.turn_steps) - int(table[i, jj]), 0)
