@@ -17,6 +17,8 @@ One module per thesis section, named in the thesis's words:
 - :mod:`~graspgait_env.planners.diagnosis`: why no gait exists (thesis 1.3 (2)-(4));
 - :mod:`~graspgait_env.planners.exact`: the exact minimum-regrasp planner (beyond the
   thesis);
+- :mod:`~graspgait_env.planners.reach`: the reach of a grasp within a few regrasps, the
+  exact planner's search cut at a depth (the envs' opt-in reach look-ahead);
 - :mod:`~graspgait_env.planners.registry`: every planner by name (``PLANNERS``),
   :func:`~graspgait_env.planners.registry.run_planner`;
 - :mod:`~graspgait_env.planners.result`: :class:`PlannerResult`, what every planner
