@@ -44,7 +44,6 @@ __all__ = [
     "Visits",
     "drop_revisits",
     "new_visits",
-    "reach_lookahead",
     "regrasp_openings",
     "visit_state",
     "state_from_observation",
@@ -184,61 +183,6 @@ def drop_revisits(model: GaitModel, mask: NDArray[np.bool_], k: int,
             continue
         if mask[a] and model.apply(s, a) == t:  # encode reads the moved contact only
             mask[a] = False
-
-
-def reach_lookahead(reach: RegraspReach, h: int, f: int, g: int, p_f: int, p_g: int, k: int,
-                    mask: NDArray[np.bool_], rot_delta: NDArray[np.int64],
-                    P: int) -> NDArray[np.float32]:
-    """The reach look-ahead entries of one state (``regrasp_lookahead = D``; see the env's
-    *Observation Space*): ``2 P x D`` per regrasp action, then ``2 R x D`` per rotation.
-
-    Held fingers ``f < g`` at workspace positions ``p_f``, ``p_g``, free finger ``h``,
-    object angle ``k``; ``mask`` the legal moves (the env's, with its opt-in
-    restrictions); ``rot_delta`` the signed grid steps of the ``2 R`` rotations. Entry
-    values are shortfalls over ``abs(K)`` grid steps (0: the turn is reached), ``(abs(K)
-    + B + 1) / abs(K)`` for an illegal action or one that opens nothing.
-    """
-    model, D = reach.model, reach.depth + 1
-    K, sign = abs(reach.turn_steps), reach._sign
-    seg = reach._seg
-    none = K - reach.unreachable  # the shortfall written for "no such move"
-    R2 = rot_delta.size
-    W_h = int(model.ws_width[h])
-    ks = k + np.concatenate(([0], rot_delta))  # object angle now, and after each rotation
-    q = np.arange(W_h)
-    best = np.full((2, D, R2 + 1, W_h), none, dtype=np.int64)
-    x0h = seg.x0[h]
-    ih = (int(model.ws_start[h]) - x0h) + q[None, :] - ks[:, None]  # h's contact index
-    inside_h = (ih >= 0) & (ih < seg.L[h])
-    ih = np.clip(ih, 0, seg.L[h] - 1)
-    for lift, (keep, p_keep) in enumerate(((g, p_g), (f, p_f))):  # l = 0 lifts f, keeps g
-        pair = _PAIR_INDEX[min(keep, h), max(keep, h)]
-        ik = int(model.ws_start[keep]) + p_keep - k - seg.x0[keep]
-        if not 0 <= ik < seg.L[keep]:
-            continue
-        for j in range(D):
-            table = reach.levels[j][pair]
-            v = table[ik, ih] if keep < h else table[ih, ik]
-            best[lift, j] = np.where(inside_h, np.maximum(K - v, 0), none)
-    A = mask.size
-    out = np.empty((2 * P + R2) * D, dtype=np.float32)
-    regrasp = np.full((P, 2, D), none, dtype=np.int64)
-    regrasp[:W_h] = best[:, :, 0, :].transpose(2, 0, 1)  # [q, lift, j]
-    legal = mask[A - 2 * P:].reshape(P, 2)
-    regrasp[~legal] = none
-    out[:2 * P * D] = regrasp.reshape(-1)
-    # after each rotation, the regrasp that is best first at depth D - 1, then D - 2, ...
-    cand = best[:, :, 1:, :].transpose(2, 0, 3, 1).reshape(R2, 2 * W_h, D)  # [rot, c, j]
-    key = (cand * (none + 1) ** np.arange(D)).sum(axis=2)
-    rot = cand[np.arange(R2), key.argmin(axis=1)]  # [rot, j]
-    rot[sign * ks[1:] >= K] = 0  # the rotation itself reaches the turn
-    rot[~mask[:R2]] = none
-    out[2 * P * D:] = rot.reshape(-1)
-    out /= K
-    return out
-
-
-_PAIR_INDEX = {(0, 1): 0, (0, 2): 1, (1, 2): 2}  # planners.exact.PAIRS order
 
 
 def regrasp_openings(model: GaitModel) -> NDArray[np.bool_]:
@@ -782,9 +726,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._look_view[...] = ((opens[self._c[f], i] | opens[self._c[g], i])
                                     & self._mask[:self._rot_delta.size])
         if self._reach is not None:
-            self._reach_view[...] = reach_lookahead(
-                self._reach, self._h, f, g, self._p[f], self._p[g], k, self._mask,
-                self._rot_delta, self.model.P)
+            self._reach_view[...] = self._reach.move_shortfalls(
+                self._h, f, g, self._p[f], self._p[g], k, self._mask, self._rot_delta)
 
     # ------------------------------------------------------------------ reward
     def _reward(self, k0: int, k1: int, move: str | None, ends: bool,

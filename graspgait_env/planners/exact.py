@@ -289,6 +289,18 @@ def _backtrack(model: GaitModel, seg: _Segments, level, goal, K: int, sign: int,
     return states
 
 
+def _to_go_window(model: GaitModel, turn_deg: float, max_backward_deg: float
+                  ) -> tuple[int, int, int, _Segments]:
+    """``(K, B, sign, segments)``: the turn and the backward reach in grid steps, the
+    turn's sign, and the segments of :class:`RegraspsToGo`'s window (object angles from
+    ``B`` against the turn to the turn itself)."""
+    K = model.turn_steps(turn_deg)
+    B = abs(model.turn_steps(max_backward_deg))
+    sign = 1 if K >= 0 else -1
+    k_lo, k_hi = (-B, K) if sign > 0 else (K, B)
+    return K, B, sign, _Segments(model, k_lo, k_hi)
+
+
 class RegraspsToGo:
     """The fewest regrasps from every state to the requested turn: one table per model.
 
@@ -325,12 +337,9 @@ class RegraspsToGo:
 
     def __init__(self, model: GaitModel, turn_deg: float = 360.0,
                  max_backward_deg: float = 360.0) -> None:
-        K = model.turn_steps(turn_deg)
-        B = abs(model.turn_steps(max_backward_deg))
-        sign = 1 if K >= 0 else -1
-        k_lo, k_hi = (-B, K) if sign > 0 else (K, B)
+        K, B, sign, seg = _to_go_window(model, turn_deg, max_backward_deg)
         self.model, self.turn_steps = model, K
-        self._seg = seg = _Segments(model, k_lo, k_hi)
+        self._seg = seg
         level = [np.full(v.shape, -1, dtype=np.int32) for v in seg.valid]
         frontier = [v & ((km >= K) if sign > 0 else (kn <= K))
                     for v, km, kn in zip(seg.valid, seg.kmax, seg.kmin, strict=True)]

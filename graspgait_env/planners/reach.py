@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.planners.exact import PAIRS, _pair_index, _Segments
+from graspgait_env.planners.exact import PAIRS, _pair_index, _to_go_window
 
 __all__ = ["MAX_REACH_DEPTH", "RegraspReach"]
 
@@ -117,12 +117,9 @@ class RegraspReach:
             raise GraspGaitInputError(
                 f"depth={depth!r}: the reach look-ahead is 0 .. {MAX_REACH_DEPTH} regrasps "
                 "deep; give e.g. 2")
-        K = model.turn_steps(turn_deg)
-        B = abs(model.turn_steps(max_backward_deg))
-        sign = 1 if K >= 0 else -1
-        k_lo, k_hi = (-B, K) if sign > 0 else (K, B)
+        K, B, sign, seg = _to_go_window(model, turn_deg, max_backward_deg)
         self.model, self.turn_steps, self.depth, self._sign = model, K, int(depth), sign
-        self._seg = seg = _Segments(model, k_lo, k_hi)
+        self._seg = seg
         self.unreachable = -(B + 1)  # below every angle of the window, towards the turn
         first = [np.where(v, km if sign > 0 else -kn, self.unreachable).astype(np.int64)
                  for v, km, kn in zip(seg.valid, seg.kmax, seg.kmin, strict=True)]
@@ -156,6 +153,58 @@ class RegraspReach:
         return out
 
     # ------------------------------------------------------------------ queries
+    def move_shortfalls(self, h: int, f: int, g: int, p_f: int, p_g: int, k: int,
+                        mask: NDArray[np.bool_], rot_delta: NDArray[np.int64]
+                        ) -> NDArray[np.float32]:
+        """Every move's look-ahead in one state, ``D = depth + 1`` regrasps deep (the envs'
+        ``regrasp_lookahead = D`` field; see ``GraspGait-v0``'s *Observation Space*):
+        ``2 P x D`` per regrasp action, then ``2 R x D`` per rotation (``GaitModel``'s
+        action layout).
+
+        Held fingers ``f < g`` at workspace positions ``p_f``, ``p_g``, free finger ``h``,
+        object angle ``k``; ``mask`` the legal moves (the env's, with its opt-in
+        restrictions); ``rot_delta`` the signed grid steps of the ``2 R`` rotations. Entry
+        values are shortfalls over ``abs(K)`` grid steps (0: the turn is reached), ``(abs(K)
+        + B + 1) / abs(K)`` for an illegal action or one that opens nothing.
+        """
+        model, D = self.model, self.depth + 1
+        K, sign, seg, P = abs(self.turn_steps), self._sign, self._seg, int(model.P)
+        none = K - self.unreachable  # the shortfall written for "no such move"
+        R2 = rot_delta.size
+        W_h = int(model.ws_width[h])
+        ks = k + np.concatenate(([0], rot_delta))  # object angle now, and after each rotation
+        q = np.arange(W_h)
+        best = np.full((2, D, R2 + 1, W_h), none, dtype=np.int64)
+        x0h = seg.x0[h]
+        ih = (int(model.ws_start[h]) - x0h) + q[None, :] - ks[:, None]  # h's contact index
+        inside_h = (ih >= 0) & (ih < seg.L[h])
+        ih = np.clip(ih, 0, seg.L[h] - 1)
+        for lift, (keep, p_keep) in enumerate(((g, p_g), (f, p_f))):  # l = 0 lifts f, keeps g
+            pair = _pair_index(keep, h)
+            ik = int(model.ws_start[keep]) + p_keep - k - seg.x0[keep]
+            if not 0 <= ik < seg.L[keep]:
+                continue
+            for j in range(D):
+                table = self.levels[j][pair]
+                v = table[ik, ih] if keep < h else table[ih, ik]
+                best[lift, j] = np.where(inside_h, np.maximum(K - v, 0), none)
+        A = mask.size
+        out = np.empty((2 * P + R2) * D, dtype=np.float32)
+        regrasp = np.full((P, 2, D), none, dtype=np.int64)
+        regrasp[:W_h] = best[:, :, 0, :].transpose(2, 0, 1)  # [q, lift, j]
+        legal = mask[A - 2 * P:].reshape(P, 2)
+        regrasp[~legal] = none
+        out[:2 * P * D] = regrasp.reshape(-1)
+        # after each rotation, the regrasp that is best first at depth D - 1, then D - 2, ...
+        cand = best[:, :, 1:, :].transpose(2, 0, 3, 1).reshape(R2, 2 * W_h, D)  # [rot, c, j]
+        key = (cand * (none + 1) ** np.arange(D)).sum(axis=2)
+        rot = cand[np.arange(R2), key.argmin(axis=1)]  # [rot, j]
+        rot[sign * ks[1:] >= K] = 0  # the rotation itself reaches the turn
+        rot[~mask[:R2]] = none
+        out[2 * P * D:] = rot.reshape(-1)
+        out /= K
+        return out
+
     def _coord(self, f: int, state: GaitState) -> int:
         """Array index of finger ``f``'s unwrapped contact at ``state``: ``x = s + p - k``."""
         model = self.model
