@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+# the CPU wheel of torch on this machine's disk; the package itself gives only a lower bound
+TORCH_VERSION ?= 2.13.0
 
 export MPLBACKEND := Agg
 export MUJOCO_GL ?= egl
@@ -13,9 +15,13 @@ $(STAMP): pyproject.toml
 	@echo "==> creating the virtual environment $(VENV)"
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	@echo "==> installing graspgait_env and its dependencies into $(VENV) (NumPy, MuJoCo,"
-	@echo "    Gymnasium, the CPU wheel of torch, stable-baselines3; about a minute on a fresh machine)"
-	$(BIN)/python -m pip install --progress-bar on -e '.[dev]'
+	@echo "==> installing the CPU wheel of torch (pinned here, not in the package: the package"
+	@echo "    asks only for torch>=2.1, and an unpinned install would pull a CUDA build)"
+	$(BIN)/python -m pip install --progress-bar on 'torch==$(TORCH_VERSION)'
+	@echo "==> installing graspgait_env with every extra into $(VENV) (NumPy, MuJoCo, Gymnasium;"
+	@echo "    [train] stable-baselines3, sb3-contrib, TensorBoard; [ray]; [zoo]; [video]; [dev]"
+	@echo "    test tools; about a minute on a fresh machine)"
+	$(BIN)/python -m pip install --progress-bar on -e '.[all,dev]' 'torch==$(TORCH_VERSION)'
 	touch $(STAMP)
 	@echo "==> $(VENV) is ready"
 
@@ -32,7 +38,7 @@ demo: $(STAMP)
 	$(BIN)/graspgait plan pentagon --mu 0.7 --planner rule \
 		--json out/pentagon_rule_plan.json --png out/pentagon_rule_gait.png
 	@echo "==> the ellipse's story, no training: the rule-based, optimal and learned gaits from one"
-	@echo "    start, on the grasp map with a comparison table (shipped agent agents/models/ellipse.zip)"
+	@echo "    start, on the grasp map with a comparison table (the shipped agent ellipse)"
 	$(BIN)/graspgait story ellipse --out out
 	@echo "==> the learned gait executed on the simulated MuJoCo hand, with a video"
 	$(BIN)/graspgait simulate out/ellipse_learned_plan.json --video out/ellipse_learned.mp4

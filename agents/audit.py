@@ -25,7 +25,8 @@ backwards) ends the pricing of the episode there (``lost_gait_at``).
 Choices, stated where the thesis is silent: ``G`` is the optimum over the env's gait
 model without the env's episode rules (``forbid_revisit``, ``forbid_reversal``: they do
 not change the fewest regrasps from a state, see the env's *Arguments*), over
-:class:`~agents.evaluate.ReferenceGaits`'s window (one turn against the requested one);
+:class:`~graspgait_env.agents.evaluate.ReferenceGaits`'s window (one turn against the requested
+one);
 a state past the turn counts as ``G = 0``.
 """
 
@@ -60,7 +61,7 @@ def audit_moves(model: GaitModel, states: Sequence[GaitState], turn_deg: float,
         has ``G = 0``.
     to_go
         ``to_go(state)``: the optimum's fewest regrasps from ``state``, None where no gait
-        exists (:meth:`agents.evaluate.ReferenceGaits.to_go`).
+        exists (:meth:`graspgait_env.agents.evaluate.ReferenceGaits.to_go`).
 
     Returns
     -------

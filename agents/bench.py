@@ -1,12 +1,12 @@
 """The shipped agents in ``graspgait bench``: the same starts as the planners, one row per run.
 
-Protocol (the bench's, :mod:`baselines.bench`): for each object and ``mu``, the 10
-starts of :func:`baselines.bench.bench_starts` (legal grasps at θ = 0 from which the
+Protocol (the bench's, :mod:`graspgait_env.baselines.bench`): for each object and ``mu``, the 10
+starts of :func:`graspgait_env.baselines.bench.bench_starts` (legal grasps at θ = 0 from which the
 exact planner finds a 360° gait). Each agent is reset at each of those starts
 (``reset(options={"start": ...})``) in ``GraspGait-v0`` with the env settings it was
 trained with (its card), the object and ``mu`` of the cell, and plays greedily
 (``deterministic=True``) until the episode ends. Each run is a
-:class:`baselines.bench.BenchCase` with ``planner = "agent:NAME"``, so the bench's
+:class:`graspgait_env.baselines.bench.BenchCase` with ``planner = "agent:NAME"``, so the bench's
 CSV, JSON and Table 1 carry the agents beside the planners; ``nodes_opened`` is 0 (an
 agent searches nothing) and ``path_length`` counts the moves made.
 
@@ -14,10 +14,10 @@ Contact models: the planners' columns use the thesis's point contacts. An agent 
 with another contact model (the hand's, ``contact_model: hand`` in its card) cannot be
 run from those starts (under the hand's maps some are not force-closure, at mu 0.8
 more), and its regrasps are not comparable with point-contact gaits. Such an agent runs
-from starts picked the bench's way (:func:`baselines.bench.bench_starts`) on its own
+from starts picked the bench's way (:func:`graspgait_env.baselines.bench.bench_starts`) on its own
 env's gait model, and its case carries the optimum's and the rule-based gait's regrasps
 from the same start under the same contact model (``contact_model``,
-``optimal_regrasps``, ``rule_regrasps``; :class:`agents.evaluate.ReferenceGaits`); the
+``optimal_regrasps``, ``rule_regrasps``; :class:`graspgait_env.agents.evaluate.ReferenceGaits`); the
 ratios of :func:`agent_rows` use those.
 
 Which agent runs where: an agent trained on ``GraspGaitRandom-v0`` (a generalist, e.g.
@@ -40,12 +40,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from graspgait_env.agents.card import (
+    load_agent,
+    resolve_model,
+    shipped_agents,
+    shipped_models_dir,
+)
+from graspgait_env.agents.envs import env_kwargs_for, make_env
+from graspgait_env.agents.evaluate import agent_predictor, play_episode
+from graspgait_env.baselines.bench import THESIS_OBJECTS, BenchCase, bench_starts
 from tqdm.auto import tqdm
 
-from agents.card import load_agent, shipped_models_dir
-from agents.envs import env_kwargs_for, make_env
-from agents.evaluate import agent_predictor, play_episode
-from baselines.bench import THESIS_OBJECTS, BenchCase, bench_starts
 from graspgait_env.atomic import atomic_write
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel
@@ -54,7 +59,8 @@ __all__ = ["SHIPPED_AGENTS", "Agent", "agents_markdown", "find_agents", "plot_be
            "run_agent_bench", "shipped_models_dir"]
 
 SHIPPED_AGENTS = ("circle", "ellipse", "pentagon", "hexagon", "random")
-"""The models ``agents/models/NAME.zip`` the project ships (issue 11)."""
+"""The agents the project ships (``models/NAME.zip`` of :mod:`graspgait_env.agents`, with
+their cards); a test fails when one is missing from the install."""
 
 
 @dataclass
@@ -78,48 +84,48 @@ class Agent:
 
 
 def find_agents(spec: str = "shipped") -> tuple[list[Agent], list[str]]:
-    """The agents named by ``spec`` and notes on those skipped.
+    """The agents named by ``spec``, loaded, and notes for the report.
 
     Parameters
     ----------
     spec
-        ``"shipped"``: every model of :data:`SHIPPED_AGENTS` present in
-        :func:`shipped_models_dir` (a missing one is skipped with a note); ``"none"``:
-        no agent; otherwise a comma-separated list of shipped names or ``.zip`` paths
-        (a missing one is an error).
+        ``"shipped"``: every shipped agent of this install
+        (:func:`~graspgait_env.agents.card.shipped_agents`); ``"none"``: no agent;
+        otherwise a comma-separated list of shipped names or ``.zip`` paths.
 
     Returns
     -------
     agents, notes
+
+    Raises
+    ------
+    GraspGaitInputError
+        An empty list, or a name that is neither a file nor a shipped agent (the message
+        lists the shipped agents).
     """
     if spec == "none":
         return [], []
-    agents, notes = [], []
-    folder = shipped_models_dir()
-    names = SHIPPED_AGENTS if spec == "shipped" else [s.strip() for s in spec.split(",")
-                                                       if s.strip()]
+    names = shipped_agents() if spec == "shipped" else [s.strip() for s in spec.split(",")
+                                                         if s.strip()]
     if not names:
         raise GraspGaitInputError(f"--agents {spec!r}: give 'shipped', 'none' or a "
-                                  "comma-separated list of names or .zip paths")
+                                  "comma-separated list of shipped names or .zip paths")
+    agents = []
     for item in names:
-        path = Path(item) if item.endswith(".zip") else folder / f"{item}.zip"
-        if not path.is_file():
-            if spec == "shipped":
-                notes.append(f"agent {item}: {path} is not there yet; skipped")
-                continue
-            raise GraspGaitInputError(
-                f"--agents {item!r}: no such model; give one of {', '.join(SHIPPED_AGENTS)} "
-                f"(in {folder}) or a path to a .zip")
+        try:
+            path = resolve_model(item)
+        except GraspGaitInputError as exc:
+            raise GraspGaitInputError(f"--agents: {exc}") from None
         model, card = load_agent(path)
         agents.append(Agent(path.stem, path, model, card))
-    return agents, notes
+    return agents, []
 
 
 def run_agent_bench(agents: Sequence[Agent], objects: Sequence[str] = THESIS_OBJECTS,
                     mus: Sequence[float] = (0.8, 0.7), starts: int = 10,
                     turn_deg: float = 360.0, progress: bool = True) -> list[BenchCase]:
     """Run each agent from the bench's starts on each object and ``mu``; one row per run."""
-    from agents.evaluate import ReferenceGaits
+    from graspgait_env.agents.evaluate import ReferenceGaits
 
     jobs = []
     envs: dict[tuple[str, str, float], Any] = {}

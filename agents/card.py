@@ -7,7 +7,7 @@ Every model ``graspgait train`` writes (final model, best model, checkpoints) is
 - ``algo`` (``maskable_ppo`` | ``ppo``), ``env_id``, ``env_kwargs`` (object, mu,
   contact model, reward weights, ...), ``wrappers``, ``contact_model`` (the env's,
   ``"point"`` before contact models existed);
-- ``config`` (every :class:`~agents.config.TrainConfig` field), ``seed``, ``steps``
+- ``config`` (every :class:`~graspgait_env.agents.config.TrainConfig` field), ``seed``, ``steps``
   (environment steps trained), ``wall_s`` (training wall time, seconds), ``run_dir``;
 - ``init`` (a run started from ``init_model`` only): ``{model, steps, wall_s}``, the
   training behind the weights it started from;
@@ -23,6 +23,7 @@ RL Zoo gets a card made from RL Zoo's saved hyper-parameters (env id, env keywor
 
 from __future__ import annotations
 
+import difflib
 import importlib.resources
 import json
 import os
@@ -34,30 +35,79 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from graspgait_env.agents.legacy import legacy_module_names, upgrade_card
 
 from graspgait_env.atomic import atomic_write, write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.extras import require_extra
 
-__all__ = ["CARD_FORMAT", "card_path", "load_agent", "read_card", "resolve_model",
-           "save_agent", "shipped_models_dir", "versions"]
+__all__ = ["CARD_FORMAT", "card_path", "describe_shipped", "load_agent", "read_card",
+           "resolve_model", "save_agent", "shipped_agents", "shipped_models_dir", "versions"]
 
 CARD_FORMAT = "graspgait-model-card/1"
 
 
 def shipped_models_dir() -> Path:
-    """``agents/models/`` (package data of :mod:`agents`: the shipped models)."""
-    return Path(str(importlib.resources.files("agents") / "models"))
+    """The folder of the shipped models (package data of :mod:`graspgait_env.agents`,
+    ``agents/models/`` in the repository): ``NAME.zip``, its card ``NAME.json`` and its
+    Markdown card ``NAME.md``."""
+    return Path(str(importlib.resources.files("graspgait_env.agents") / "models"))
+
+
+def shipped_agents() -> list[str]:
+    """Names of the shipped agents (``["circle", "ellipse", ...]``), sorted: the stems of
+    the model zips in :func:`shipped_models_dir` that have a card beside them."""
+    folder = shipped_models_dir()
+    return sorted(p.stem for p in folder.glob("*.zip") if card_path(p).is_file())
+
+
+def describe_shipped() -> list[tuple[str, str]]:
+    """``(name, one line)`` per shipped agent: its env id, object or level, and the
+    figures of its card's latest evaluation (success over the starts with a gait,
+    regrasps against the optimum)."""
+    rows = []
+    for name in shipped_agents():
+        card = read_card(shipped_models_dir() / f"{name}.zip")
+        kw = card.get("env_kwargs") or {}
+        what = (f"object {kw['object']}" if "object" in kw
+                else f"level {kw['level']}" if "level" in kw else "")
+        ev = card.get("eval") or {}
+        figs = []
+        if ev.get("success_rate_solvable") is not None:
+            figs.append(f"{ev['success_rate_solvable']:.0%} of the starts with a gait")
+        if ev.get("regrasps_vs_optimal") is not None:
+            figs.append(f"{ev['regrasps_vs_optimal']:.3f}x the optimum")
+        line = ", ".join(x for x in (card.get("env_id", "?"), what, *figs) if x)
+        rows.append((name, line))
+    return rows
 
 
 def resolve_model(spec: str | os.PathLike[str]) -> Path:
-    """A model's path: ``spec`` as a path, or a shipped model's name (``hexagon`` ->
-    ``agents/models/hexagon.zip`` of the installed package) when no such file exists."""
+    """A model's path: ``spec`` as a path when it names a file (``.zip`` optional), else a
+    shipped agent's name (``"hexagon"`` -> the installed package's ``models/hexagon.zip``).
+
+    Raises
+    ------
+    GraspGaitInputError
+        Neither a file nor a shipped agent; the message lists the shipped agents.
+    """
     path = Path(spec)
-    if not path.is_file() and path.suffix != ".zip" and len(path.parts) == 1:
-        shipped = shipped_models_dir() / f"{path.name}.zip"
+    if path.is_file():
+        return path
+    if path.suffix != ".zip" and path.with_suffix(".zip").is_file():
+        return path.with_suffix(".zip")
+    if len(path.parts) == 1:
+        shipped = shipped_models_dir() / f"{path.stem if path.suffix == '.zip' else path.name}.zip"
         if shipped.is_file():
             return shipped
-    return path
+    names = shipped_agents()
+    near = difflib.get_close_matches(str(spec), names, n=1)
+    hint = f"did you mean {near[0]!r}? " if near else ""
+    raise GraspGaitInputError(
+        f"MODEL {str(spec)!r}: no such file and no shipped agent of that name; {hint}give a "
+        f"shipped agent ({', '.join(names) or 'none in this install'}; `graspgait evaluate "
+        "--list` describes them) or the path of a .zip saved by `graspgait train` (its "
+        "run folder's model.zip)")
 
 
 def card_path(model_path: str | os.PathLike[str]) -> Path:
@@ -124,7 +174,7 @@ def read_card(model_path: str | os.PathLike[str]) -> dict[str, Any]:
                                   "to load the model without one") from None
     if not isinstance(card, dict):
         raise GraspGaitInputError(f"model card {str(p)!r}: must be a JSON object")
-    return card
+    return upgrade_card(card)  # the import paths of a card written by 0.1
 
 
 class _RLZooLoader(yaml.SafeLoader):
@@ -179,6 +229,16 @@ def _is_maskable(path: Path) -> bool:
 def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple[Any, dict]:
     """Load a saved agent and its card.
 
+    Parameters
+    ----------
+    model_path
+        A shipped agent's name (``"ellipse"``; :func:`shipped_agents`) or the path of a
+        model zip (``.zip`` may be left out). A model saved by graspgait_env 0.1 (whose
+        pickles and card name the packages ``agents`` / ``baselines``) loads too
+        (:mod:`graspgait_env.agents.legacy`).
+    device
+        The torch device of the model.
+
     The algorithm is read from the zip: MaskablePPO when its policy class is a maskable
     one, else PPO (the returned card's ``algo`` says which).
 
@@ -190,15 +250,18 @@ def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple
     Raises
     ------
     GraspGaitInputError
-        No such file, or not an SB3 model zip.
+        Neither a file nor a shipped agent, or not an SB3 model zip.
+    MissingExtraError
+        The ``[train]`` extra (torch, stable-baselines3, ...) is not installed.
+
+    Examples
+    --------
+    >>> model, card = load_agent("ellipse")  # doctest: +SKIP
+    >>> card["env_id"]  # doctest: +SKIP
+    'GraspGait-v0'
     """
-    path = Path(model_path)
-    if not path.is_file() and path.suffix != ".zip" and path.with_suffix(".zip").is_file():
-        path = path.with_suffix(".zip")
-    if not path.is_file():
-        raise GraspGaitInputError(f"MODEL {str(model_path)!r}: no such file; give a .zip saved "
-                                  "by `graspgait train` (e.g. runs/<run>/model.zip or "
-                                  "agents/models/ellipse.zip)")
+    require_extra("train", "load_agent")
+    path = resolve_model(model_path)
     card = read_card(path) or _rlzoo_card(path)
     # the zip itself says which algorithm saved it (a card may be stale or RL Zoo's)
     card["algo"] = algo = "maskable_ppo" if _is_maskable(path) else "ppo"
@@ -207,7 +270,8 @@ def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple
     else:
         from stable_baselines3 import PPO as cls
     try:
-        model = cls.load(path, device=device)
+        with legacy_module_names():  # a model saved by graspgait_env 0.1 names `agents`
+            model = cls.load(path, device=device)
     except (zipfile.BadZipFile, KeyError, ValueError) as exc:
         raise GraspGaitInputError(f"MODEL {str(model_path)!r}: not a stable-baselines3 model "
                                   f"zip ({type(exc).__name__}: {exc})") from None

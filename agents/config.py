@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from graspgait_env.agents.legacy import upgrade_import_path
 
 from graspgait_env.envs.config import check_count, check_number
 from graspgait_env.envs.registration import ENV_IDS
@@ -42,11 +43,11 @@ __all__ = [
 ALGOS = ("maskable_ppo", "ppo")
 """``maskable_ppo``: sb3-contrib MaskablePPO (reads the env's ``action_masks()``);
 ``ppo``: stable-baselines3 PPO (no masks; pair it with
-:class:`agents.wrappers.LegalActionWrapper`)."""
+:class:`graspgait_env.agents.wrappers.LegalActionWrapper`)."""
 VEC_ENVS = ("dummy", "subproc", "batched")
 """SB3 vector envs: ``dummy`` steps the envs in this process, one after the other;
 ``subproc`` runs one process per env; ``batched`` steps all ``n_envs`` in one NumPy call
-(:mod:`agents.vec_env`; ``GraspGait-v0`` without wrappers only, same transitions)."""
+(:mod:`graspgait_env.agents.vec_env`; ``GraspGait-v0`` without wrappers only, same transitions)."""
 ACTIVATIONS = ("tanh", "relu")
 
 
@@ -98,8 +99,8 @@ def _check_import_path(name: str, value: Any) -> str:
     if not ok:
         raise GraspGaitInputError(
             f"{name}={value!r}: give an import path 'package.module:Name', e.g. "
-            "'agents.wrappers:LegalActionWrapper'")
-    return value
+            "'graspgait_env.agents.wrappers:LegalActionWrapper'")
+    return upgrade_import_path(value, warn=True)  # 0.1's agents.X / baselines.X
 
 
 def _check_import_paths(name: str, value: Any, example: str) -> list[str]:
@@ -127,7 +128,8 @@ def _check_net_arch(value: Any) -> list[int] | dict[str, list[int]]:
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """Hyper-parameters of one training run (``graspgait train``, :func:`agents.train.train`).
+    """Hyper-parameters of one training run (``graspgait train``,
+    :func:`graspgait_env.agents.train.train`).
 
     The PPO fields keep stable-baselines3's names and meaning (``PPO(n_steps=...,
     batch_size=...)``). Values are checked at construction; numbers are stored as Python
@@ -156,17 +158,18 @@ class TrainConfig:
     ``contact_model``, the GraspGaitConfig fields (reward weights, map window, ...)."""
     wrappers: list[str] = field(default_factory=list)
     """Gymnasium wrappers applied to every env, innermost first, as import paths
-    (``"agents.wrappers:LegalActionWrapper"``)."""
+    (``"graspgait_env.agents.wrappers:LegalActionWrapper"``)."""
     train_wrappers: list[str] = field(default_factory=list)
     """Gymnasium wrappers of the training envs only, outside ``wrappers``, as import paths
-    (``"agents.wrappers:RuleBasedStartWrapper"``, a start distribution): the periodic
+    (``"graspgait_env.agents.wrappers:RuleBasedStartWrapper"``, a start distribution): the periodic
     evaluation and ``graspgait evaluate`` run without them, and the card's ``wrappers``
     leaves them out."""
     policy: str = "MlpPolicy"
     """SB3's ``MlpPolicy``, or the import path of a policy class: with ``algo:
-    maskable_ppo``, ``agents.policies:MaskableRegraspScorerPolicy`` (SB3's network plus a
+    maskable_ppo``, ``graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` (SB3's network
+    plus a
     regrasp scorer shared by every regrasp action; needs ``features_extractor:
-    agents.policies:GraspMapExtractor`` with ``workspace_widths``)."""
+    graspgait_env.agents.policies:GraspMapExtractor`` with ``workspace_widths``)."""
     net_arch: list[int] | dict[str, list[int]] = field(default_factory=lambda: [64, 64])
     """Hidden layer widths of the policy and value networks (a list: shared sizes, separate
     networks; or ``{pi: [...], vf: [...]}``)."""
@@ -210,7 +213,8 @@ class TrainConfig:
     """Episodes per evaluation, from fixed starts (seeds 10000, 10001, ...)."""
     best_success_floor: float | None = None
     """How ``best.zip`` is chosen among the periodic evaluations
-    (:func:`agents.train.selection_score`): None ranks them by success rate over solvable
+    (:func:`graspgait_env.agents.train.selection_score`): None ranks them by success rate over
+    solvable
     starts, then by fewest regrasps relative to the optimum; a number in [0, 1] ranks
     those reaching that success rate above the others and, among them, by regrasps
     relative to the optimum alone (issue 11's acceptance: 0.98, then the fewest regrasps)."""
@@ -254,9 +258,9 @@ class TrainConfig:
                                       "e.g. {object: ellipse, mu: 0.7}")
         put("env_kwargs", dict(self.env_kwargs))
         put("wrappers", _check_import_paths("wrappers", self.wrappers,
-                                            "agents.wrappers:LegalActionWrapper"))
+                                            "graspgait_env.agents.wrappers:LegalActionWrapper"))
         put("train_wrappers", _check_import_paths("train_wrappers", self.train_wrappers,
-                                                  "agents.wrappers:RuleBasedStartWrapper"))
+                                                  "graspgait_env.agents.wrappers:RuleBasedStartWrapper"))
         if self.policy != "MlpPolicy":
             put("policy", _check_import_path("policy", self.policy))
             if self.algo != "maskable_ppo" and "Maskable" in self.policy:

@@ -37,7 +37,7 @@ def import_object(path: str, what: str = "wrappers") -> Any:
     except (ImportError, AttributeError, ValueError) as exc:
         raise GraspGaitInputError(f"{what}={path!r}: cannot import it ({exc}); give "
                                   "'package.module:Name', e.g. "
-                                  "'agents.wrappers:LegalActionWrapper'") from None
+                                  "'graspgait_env.agents.wrappers:LegalActionWrapper'") from None
 
 
 def make_env(env_id: str, env_kwargs: Mapping[str, Any] | None = None,

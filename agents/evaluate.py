@@ -45,12 +45,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from graspgait_env.agents.audit import audit_moves, summarize_audits
+from graspgait_env.agents.card import load_agent
+from graspgait_env.agents.envs import contact_model_of, env_kwargs_for, make_env
+from graspgait_env.agents.seeding import seed_everything
 from tqdm.auto import tqdm
 
-from agents.audit import audit_moves, summarize_audits
-from agents.card import load_agent
-from agents.envs import contact_model_of, env_kwargs_for, make_env
-from agents.seeding import seed_everything
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.envs.config import check_count, check_mu, check_object
 from graspgait_env.envs.registration import ENV_IDS
@@ -97,7 +97,7 @@ class ReferenceGaits:
     def to_go(self, model: GaitModel, state: GaitState, turn_deg: float) -> int | None:
         """The optimum's fewest regrasps for the turn from any gait state ``state`` (None:
         no gait from it, or it lies outside the window), from the same cached table as
-        :meth:`optimal_regrasps` (:mod:`agents.audit` prices moves with it)."""
+        :meth:`optimal_regrasps` (:mod:`graspgait_env.agents.audit` prices moves with it)."""
         from graspgait_env.planners.exact import RegraspsToGo
 
         key = (self._model_key(model), model.turn_steps(turn_deg))
@@ -233,7 +233,7 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
     predict
         ``predict(observation, action_mask) -> action``.
     env
-        A GraspGait env made by :func:`agents.envs.make_env` (any id, wrapped or not).
+        A GraspGait env made by :func:`graspgait_env.agents.envs.make_env` (any id, wrapped or not).
     episodes
         Number of episodes; episode ``i`` resets with seed ``seed + i``.
     seed
@@ -244,7 +244,7 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
         Show a tqdm bar.
     audit
         Add ``audit`` to each record: every move priced against the optimum
-        (:func:`agents.audit.audit_moves`).
+        (:func:`graspgait_env.agents.audit.audit_moves`).
 
     Returns
     -------
@@ -253,7 +253,7 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
         ``success``, ``solvable`` (a gait exists from the start), ``regrasps``,
         ``path_length`` (moves made: regrasps + rotations), ``steps`` (actions, illegal
         ones included), ``illegal_actions`` (actions the agent chose that were not legal
-        moves; a wrapper such as :class:`agents.wrappers.LegalActionWrapper` may have
+        moves; a wrapper such as :class:`graspgait_env.agents.wrappers.LegalActionWrapper` may have
         played a legal one instead), ``optimal_regrasps`` and ``rule_regrasps`` (None:
         no gait found), ``wall_s`` (the agent's episode, references excluded).
     """
@@ -283,15 +283,18 @@ def batched_eval_env(env_id: str, env_kwargs: Mapping[str, Any] | None = None,
                      ) -> Any:
     """The batched env for :func:`run_episodes_batched`, or None where it does not apply.
 
-    It applies to ``GraspGait-v0`` without wrappers (the env the batched
-    :class:`~graspgait_env.envs.vector_env.GraspGaitVectorEnv` reproduces, every config
-    field of it supported); other ids (``GraspGaitRandom-v0``, ``GraspGaitMujoco-v1``) and
-    wrapped envs return None, and the caller plays them one by one (:func:`run_episodes`).
-    Bad keywords raise as the single env raises them.
+    It applies to ``GraspGait-v0`` without wrappers, with the config fields that the
+    batched :class:`~graspgait_env.envs.vector_env.GraspGaitVectorEnv` reproduces
+    transition for transition; other ids (``GraspGaitRandom-v0``, ``GraspGaitMujoco-v1``),
+    wrapped envs and fields the batched step does not implement (e.g.
+    ``regrasp_lookahead``; :func:`~graspgait_env.envs.vector_env.unsupported_fields`)
+    return None, and the caller plays the episodes one by one (:func:`run_episodes`), which
+    gives the same records. Bad keywords raise as the single env raises them.
     """
-    if env_id != "GraspGait-v0" or wrappers:
+    from graspgait_env.envs.vector_env import GraspGaitVectorEnv, unsupported_fields
+
+    if env_id != "GraspGait-v0" or wrappers or unsupported_fields(dict(env_kwargs or {})):
         return None
-    from graspgait_env.envs.vector_env import GraspGaitVectorEnv
 
     return GraspGaitVectorEnv(num_envs=check_count("num_envs", num_envs, 1, EVAL_BATCH),
                               **dict(env_kwargs or {}))
@@ -484,7 +487,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         First reset seed.
     deterministic
         Greedy actions (the policy's mode) when True; else sampled, from torch seeded
-        with ``seed`` (:func:`agents.seeding.seed_everything`).
+        with ``seed`` (:func:`graspgait_env.agents.seeding.seed_everything`).
     env_overrides
         Further keyword arguments of the env (e.g. ``{"object_seeds": [1000000,
         1100000], "exclude_seeds": None, "bundled_fraction": 0}`` for held-out
@@ -492,7 +495,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
     progress
         Show a progress bar.
     audit
-        Price every move against the optimum (:mod:`agents.audit`): each record gains
+        Price every move against the optimum (:mod:`graspgait_env.agents.audit`): each record gains
         ``audit``, the result ``audit``, the sums over the successful episodes from
         solvable starts (their ``excess_regrasps`` is the agent's regrasps there less
         the optimum's). The episodes are then played one by one (the same records as

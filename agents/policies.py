@@ -2,7 +2,7 @@
 and a policy that scores every regrasp with one shared network.
 
 :class:`GraspMapExtractor` is an SB3 features extractor (``features_extractor:
-agents.policies:GraspMapExtractor`` in a training config). It splits the flat
+graspgait_env.agents.policies:GraspMapExtractor`` in a training config). It splits the flat
 observation at :class:`graspgait_env.envs.map_env.ObservationLayout`'s slices and reads
 each part with the structure it has:
 
@@ -68,7 +68,7 @@ through unchanged too. The features are the concatenation (header and mask, wind
 features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
 ``MlpPolicy``. The class
 and its keyword arguments are saved in the model zip by SB3 (``policy_kwargs``) and
-rebuilt on load, so a model trained with it loads with :func:`agents.card.load_agent`
+rebuilt on load, so a model trained with it loads with :func:`graspgait_env.agents.card.load_agent`
 as any other (``tests/agents/test_policies.py``).
 """
 
@@ -545,8 +545,9 @@ class _ScoredActionNet(nn.Module):
 class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     """sb3-contrib's maskable actor-critic with a **shared regrasp scorer**.
 
-    ``policy: agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
-    ``algo: maskable_ppo`` and ``features_extractor: agents.policies:GraspMapExtractor``
+    ``policy: graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
+    ``algo: maskable_ppo`` and ``features_extractor:
+    graspgait_env.agents.policies:GraspMapExtractor``
     given ``workspace_widths``, ``turn_steps`` and ``rotations``; the policy sets the
     extractor's ``regrasp_block``).
 
@@ -586,8 +587,9 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
         if extractor is None or not issubclass(extractor, GraspMapExtractor):
             raise GraspGaitInputError(
                 f"policy MaskableRegraspScorerPolicy with features_extractor {extractor!r}: "
-                "needs agents.policies:GraspMapExtractor (it computes the regrasp block); "
-                "set features_extractor: agents.policies:GraspMapExtractor with "
+                "needs graspgait_env.agents.policies:GraspMapExtractor (it computes the regrasp "
+                "block); "
+                "set features_extractor: graspgait_env.agents.policies:GraspMapExtractor with "
                 "workspace_widths, turn_steps and rotations")
         kwargs["features_extractor_kwargs"] = {**(kwargs.get("features_extractor_kwargs") or {}),
                                                "regrasp_block": True}

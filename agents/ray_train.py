@@ -1,14 +1,15 @@
 """Training over many seeds (Ray Tune trials) and evaluation split over Ray tasks.
 
 - :func:`train_seeds`: ``graspgait train CONFIG --seeds 0-9 [--ray [ADDRESS]]``: one
-  :func:`agents.train.train` run per seed, each its own run folder; on Ray, one Ray
+  :func:`graspgait_env.agents.train.train` run per seed, each its own run folder; on Ray, one Ray
   Tune trial per seed (``tune.grid_search`` over the seeds, one trial per
   ``torch_threads`` CPUs), serially without ``--ray``. A trial runs exactly what the
   serial run does (same config, same seed, same torch threads), so its numbers are the
   serial run's. A failed trial is reported and the others kept.
 - :func:`evaluate_on_ray`: ``graspgait evaluate MODEL --ray``: the episodes split into
   chunks of consecutive reset seeds, one Ray task per chunk, each running
-  :func:`agents.evaluate.evaluate`; the per-episode records are joined in seed order and
+  :func:`graspgait_env.agents.evaluate.evaluate`; the per-episode records are joined in seed order
+  and
   summarized once, so the result equals the serial evaluation's (wall times aside). The
   model file travels through Ray's object store, so the workers need not share a disk.
 
@@ -28,7 +29,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from agents.config import TrainConfig
+from graspgait_env.agents.config import TrainConfig
+
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["SeedOutcome", "evaluate_on_ray", "train_seeds"]
@@ -47,7 +49,7 @@ class SeedOutcome:
     steps, wall_s
         Env-steps trained and the training wall time (s).
     last_eval
-        The final evaluation's numbers (:func:`agents.evaluate.summarize_episodes`).
+        The final evaluation's numbers (:func:`graspgait_env.agents.evaluate.summarize_episodes`).
     error
         None, or the error that ended the trial.
     """
@@ -63,7 +65,7 @@ class SeedOutcome:
 
 def _run_one(config: TrainConfig, seed: int) -> dict[str, Any]:
     """Train ``config`` with ``seed`` (quietly); the outcome as plain data."""
-    from agents.train import train
+    from graspgait_env.agents.train import train
 
     r = train(replace(config, seed=int(seed)), progress=False)
     return {"seed": int(seed), "run_dir": str(r.run_dir), "model_path": str(r.model_path),
@@ -110,10 +112,9 @@ def train_seeds(config: TrainConfig, seeds: Sequence[int], *, use_ray: bool = Fa
 def _tune_seeds(config: TrainConfig, seeds: list[int], address: str | None,
                 progress: bool) -> list[SeedOutcome]:
     """One Ray Tune trial per seed; outcomes in seed order."""
+    from graspgait_env.baselines.scale_out import ray_session
     from ray import tune
     from tqdm.auto import tqdm
-
-    from baselines.scale_out import ray_session
 
     def trainable(params: dict[str, Any]) -> None:
         out = _run_one(config, params["seed"])
@@ -161,7 +162,7 @@ def _tune_seeds(config: TrainConfig, seeds: list[int], address: str | None,
 def _evaluate_chunk(files: dict[str, bytes], name: str, kwargs: dict[str, Any]
                     ) -> dict[str, Any]:
     """Write the model (and its card) into a temporary folder and evaluate it there."""
-    from agents.evaluate import evaluate
+    from graspgait_env.agents.evaluate import evaluate
 
     with tempfile.TemporaryDirectory(prefix="graspgait-eval-") as tmp:
         for suffix, data in files.items():
@@ -172,7 +173,7 @@ def _evaluate_chunk(files: dict[str, bytes], name: str, kwargs: dict[str, Any]
 def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, seed: int = 0,
                     chunks: int | None = None, address: str | None = None,
                     progress: bool = True, **kwargs: Any) -> dict[str, Any]:
-    """:func:`agents.evaluate.evaluate` with its episodes split over Ray tasks.
+    """:func:`graspgait_env.agents.evaluate.evaluate` with its episodes split over Ray tasks.
 
     Parameters
     ----------
@@ -203,8 +204,9 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
     """
     import time
 
-    from agents.evaluate import evaluate, summarize_episodes
-    from baselines.scale_out import ray_session, run_tasks
+    from graspgait_env.agents.evaluate import evaluate, summarize_episodes
+    from graspgait_env.baselines.scale_out import ray_session, run_tasks
+
     from graspgait_env.envs.config import check_count
 
     episodes = check_count("episodes", episodes, 1, 100)
@@ -256,8 +258,8 @@ def _model_files(path: Path) -> dict[str, bytes]:
 def _bench_agent_cell(files: dict[str, bytes], name: str, obj: str, mu: float, starts: int,
                       turn_deg: float) -> list[Any]:
     """The serial agent bench of one agent on one (object, mu) cell (in a Ray worker)."""
-    from agents.bench import Agent, run_agent_bench
-    from agents.card import load_agent
+    from graspgait_env.agents.bench import Agent, run_agent_bench
+    from graspgait_env.agents.card import load_agent
 
     with tempfile.TemporaryDirectory(prefix="graspgait-bench-") as tmp:
         for suffix, data in files.items():
@@ -272,7 +274,8 @@ def bench_agents_on_ray(agents: Sequence[Any], objects: Sequence[str],
                         mus: Sequence[float], starts: int = 10, turn_deg: float = 360.0, *,
                         address: str | None = None, progress: bool = True
                         ) -> tuple[list[Any], list[Any]]:
-    """:func:`agents.bench.run_agent_bench` with one Ray task per agent, object and mu.
+    """:func:`graspgait_env.agents.bench.run_agent_bench` with one Ray task per agent, object and
+    mu.
 
     Each task runs the serial agent bench on its cell (the model and its card travel
     as bytes, so a remote cluster needs no copy of the files), and the cells' rows are
@@ -283,7 +286,7 @@ def bench_agents_on_ray(agents: Sequence[Any], objects: Sequence[str],
     Parameters
     ----------
     agents
-        :class:`agents.bench.Agent` items (``find_agents``).
+        :class:`graspgait_env.agents.bench.Agent` items (``find_agents``).
     objects, mus, starts, turn_deg
         As for ``run_agent_bench``.
     address
@@ -292,11 +295,11 @@ def bench_agents_on_ray(agents: Sequence[Any], objects: Sequence[str],
     Returns
     -------
     cases, failures
-        The :class:`~baselines.bench.BenchCase` rows of the cells that ran, and the
-        failed cells (:class:`~baselines.scale_out.TaskFailure`, label
+        The :class:`~graspgait_env.baselines.bench.BenchCase` rows of the cells that ran, and the
+        failed cells (:class:`~graspgait_env.baselines.scale_out.TaskFailure`, label
         ``"agent NAME on OBJECT mu=MU"``).
     """
-    from baselines.scale_out import ray_session, run_tasks
+    from graspgait_env.baselines.scale_out import ray_session, run_tasks
 
     cells = [(o, float(mu), a) for o in objects for mu in mus for a in agents if a.runs_on(o)]
     if not cells:

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+from graspgait_env.agents.config import default_torch_threads
+from graspgait_env.agents.seeding import set_torch_threads
 from stable_baselines3.common.callbacks import BaseCallback
-
-from agents.config import default_torch_threads
-from agents.seeding import set_torch_threads
 
 __all__ = ["TorchThreadsCallback"]
 
@@ -17,14 +16,15 @@ class TorchThreadsCallback(BaseCallback):
     core) unless ``--num-threads`` is given. The networks here are small MLPs, and extra
     threads only contend with the environment steps: on a 2-core machine under load,
     torch's default ran RL Zoo's PPO at 39 env steps/s, against hundreds with one
-    thread (issue 11). This callback applies :func:`agents.config.default_torch_threads`
+    thread (issue 11). This callback applies
+    :func:`graspgait_env.agents.config.default_torch_threads`
     (1 up to 4 cores), as ``graspgait train`` does; an explicit ``--num-threads`` given to
     RL Zoo is overridden only when ``threads`` is None and the default differs.
 
     Parameters
     ----------
     threads
-        Torch intra-op threads; None: :func:`agents.config.default_torch_threads`.
+        Torch intra-op threads; None: :func:`graspgait_env.agents.config.default_torch_threads`.
     """
 
     def __init__(self, threads: int | None = None, verbose: int = 0) -> None:

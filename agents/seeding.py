@@ -32,7 +32,8 @@ def seed_everything(seed: int) -> None:
 
 
 def set_torch_threads(threads: int) -> None:
-    """Set torch's intra-op threads (see :func:`agents.config.default_torch_threads`)."""
+    """Set torch's intra-op threads (see
+    :func:`graspgait_env.agents.config.default_torch_threads`)."""
     import torch
 
     torch.set_num_threads(int(threads))

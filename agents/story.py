@@ -25,10 +25,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from graspgait_env.agents.card import load_agent
+from graspgait_env.agents.envs import env_kwargs_for, make_env
+from graspgait_env.agents.evaluate import agent_predictor
 
-from agents.card import load_agent
-from agents.envs import env_kwargs_for, make_env
-from agents.evaluate import agent_predictor
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import Plan, plan_from_states
@@ -102,7 +102,7 @@ def gait_model_of(model_path: str | os.PathLike[str], object: Any = None,  # noq
                   mu: float | None = None) -> GaitModel:
     """The gait model the story plays the agent on (the card's object, ``mu``, hand, grid
     and contact model, object and ``mu`` replaced if given): for parsing a start grasp."""
-    from agents.card import read_card
+    from graspgait_env.agents.card import read_card
 
     env = _story_env(read_card(model_path), object, mu)
     try:

@@ -1,8 +1,8 @@
 """Training throughput: MaskablePPO on the batched ``GraspGait-v0`` beside ``DummyVecEnv``.
 
-Two measurements, each for ``vec_env="batched"`` (:mod:`agents.vec_env`) and
+Two measurements, each for ``vec_env="batched"`` (:mod:`graspgait_env.agents.vec_env`) and
 ``vec_env="dummy"`` (SB3's ``DummyVecEnv`` over ``gymnasium.make`` envs), with the same
-training config (:func:`agents.config.load_train_config`; the bundled ``ellipse`` by
+training config (:func:`graspgait_env.agents.config.load_train_config`; the bundled ``ellipse`` by
 default) and seed:
 
 - :func:`ppo_steps_per_s`: env-steps per second of ``MaskablePPO.learn`` (rollouts and
@@ -12,7 +12,7 @@ default) and seed:
   ``eval_every`` steps, ``eval_episodes`` episodes from the starts of training's
   periodic evaluation (reset seeds ``EVAL_SEED + i``), played together in one batched
   env, each until its first episode ends. Measured once; the README gives the command
-  (``python -m agents.throughput``) and the figures.
+  (``python -m graspgait_env.agents.throughput``) and the figures.
 
 Both vector envs give the same transitions for the same seeds, so the two runs learn the
 same policy step for step; only the wall time differs.
@@ -28,11 +28,11 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from graspgait_env.agents.config import load_train_config
+from graspgait_env.agents.evaluate import EVAL_SEED
+from graspgait_env.agents.seeding import seed_everything, set_torch_threads
+from graspgait_env.agents.train import build_model, make_vec_env_for
 
-from agents.config import load_train_config
-from agents.evaluate import EVAL_SEED
-from agents.seeding import seed_everything, set_torch_threads
-from agents.train import build_model, make_vec_env_for
 from graspgait_env.envs.vector_env import GraspGaitVectorEnv
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.timing import BenchRow, register
@@ -197,7 +197,8 @@ def bench_rows(repeat: int) -> list[BenchRow]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line: time to 95% success for each vec env; print JSON."""
-    ap = argparse.ArgumentParser(prog="python -m agents.throughput", description=__doc__,
+    ap = argparse.ArgumentParser(prog="python -m graspgait_env.agents.throughput",
+                                 description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--config", default="ellipse", help="training config (default ellipse)")
     ap.add_argument("--vec-env", action="append", choices=("batched", "dummy", "subproc"),

@@ -1,4 +1,5 @@
-"""Train a PPO or MaskablePPO agent on a GraspGait env from a :class:`~agents.config.TrainConfig`.
+"""Train a PPO or MaskablePPO agent on a GraspGait env from a
+:class:`~graspgait_env.agents.config.TrainConfig`.
 
 A run lives in its own folder, ``{run_root}/{env_id}-{config name}-s{seed}-{YYYYmmdd-HHMMSS}``:
 
@@ -12,7 +13,7 @@ A run lives in its own folder, ``{run_root}/{env_id}-{config name}-s{seed}-{YYYY
 - ``best.zip`` (+ card): the model of the best evaluation (:func:`selection_score`:
   highest success rate over solvable starts, then fewest regrasps relative to the
   optimum; with ``best_success_floor``, fewest regrasps among those reaching it);
-- ``model.zip`` + ``model.json``: the final model and its card (:mod:`agents.card`).
+- ``model.zip`` + ``model.json``: the final model and its card (:mod:`graspgait_env.agents.card`).
 
 With ``init_model`` the run starts from the weights of a saved model (a curriculum: the
 same network trained on under a new reward); its card's ``init`` says how many steps and
@@ -22,9 +23,9 @@ The periodic evaluation (every ``eval_freq`` steps and at the end) plays
 ``eval_episodes`` episodes from fixed starts (reset seeds 10000, 10001, ...) in a
 separate env made like the training ones, greedy actions, and compares the agent with
 the exact optimum and the rule-based gait from the same starts
-(:func:`agents.evaluate.run_episodes`; the references are computed once per start). In
+(:func:`graspgait_env.agents.evaluate.run_episodes`; the references are computed once per start). In
 ``GraspGait-v0`` without wrappers the episodes run side by side in the batched env
-(:func:`agents.evaluate.run_episodes_batched`, the same records).
+(:func:`graspgait_env.agents.evaluate.run_episodes_batched`, the same records).
 """
 
 from __future__ import annotations
@@ -38,12 +39,10 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from tqdm.auto import tqdm
-
-from agents.card import load_agent, read_card, resolve_model, save_agent
-from agents.config import TrainConfig
-from agents.envs import contact_model_of, import_object, make_env
-from agents.evaluate import (
+from graspgait_env.agents.card import load_agent, read_card, resolve_model, save_agent
+from graspgait_env.agents.config import TrainConfig
+from graspgait_env.agents.envs import contact_model_of, import_object, make_env
+from graspgait_env.agents.evaluate import (
     EVAL_BATCH,
     EVAL_SEED,
     ReferenceGaits,
@@ -54,9 +53,12 @@ from agents.evaluate import (
     run_episodes_batched,
     summarize_episodes,
 )
-from agents.seeding import seed_everything, set_torch_threads
+from graspgait_env.agents.seeding import seed_everything, set_torch_threads
+from tqdm.auto import tqdm
+
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.extras import require_extra
 
 __all__ = ["TrainResult", "train", "run_name", "build_model", "make_vec_env_for",
            "selection_score", "init_from_model"]
@@ -77,7 +79,7 @@ class TrainResult:
     wall_s
         Training wall time (s), including the runs this one resumed.
     last_eval
-        The final evaluation's numbers (:func:`agents.evaluate.summarize_episodes`).
+        The final evaluation's numbers (:func:`graspgait_env.agents.evaluate.summarize_episodes`).
     """
 
     run_dir: Path
@@ -94,7 +96,8 @@ def selection_score(summary: dict[str, Any],
     Parameters
     ----------
     summary
-        :func:`agents.evaluate.summarize_episodes`' numbers (``success_rate_solvable``,
+        :func:`graspgait_env.agents.evaluate.summarize_episodes`' numbers
+        (``success_rate_solvable``,
         ``regrasps_vs_optimal``; None counts as 0 success and infinitely many regrasps).
     success_floor
         None: ``(success rate, -regrasps vs optimum)``, success first. A rate in [0, 1]:
@@ -148,7 +151,7 @@ def make_vec_env_for(config: TrainConfig, n_envs: int | None = None) -> Any:
     wrappers = (*config.wrappers, *config.train_wrappers)  # training envs: both
     make_env(env_id, kwargs, wrappers).close()  # bad keywords fail here, in this process
     if config.vec_env == "batched":
-        from agents.vec_env import make_batched_vec_env
+        from graspgait_env.agents.vec_env import make_batched_vec_env
 
         if env_id != "GraspGait-v0" or wrappers:
             raise GraspGaitInputError(
@@ -324,11 +327,10 @@ def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
         No such file, or a model of another algorithm, observation or action space, or
         network.
     """
-    path = resolve_model(str(config.init_model))
-    if not path.is_file():
-        raise GraspGaitInputError(f"init_model={str(config.init_model)!r}: no such model; "
-                                  "give a saved model's path or a shipped model's name, "
-                                  "e.g. ellipse")
+    try:
+        path = resolve_model(str(config.init_model))
+    except GraspGaitInputError as exc:  # the message lists the shipped agents
+        raise GraspGaitInputError(f"init_model: {exc}") from None
     source, card = load_agent(path, device=config.device)  # its algo read from the zip
     if card["algo"] != config.algo:
         raise GraspGaitInputError(f"init_model={str(path)!r}: a {card['algo']} model, the "
@@ -373,7 +375,7 @@ def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
     Parameters
     ----------
     config
-        The hyper-parameters (:func:`agents.config.load_train_config`).
+        The hyper-parameters (:func:`graspgait_env.agents.config.load_train_config`).
     run_dir
         The run's folder; default a new one under ``config.run_root`` named by
         :func:`run_name` (or, with ``resume``, the checkpoint's run folder).
@@ -394,7 +396,10 @@ def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
     GraspGaitInputError
         Bad env keywords, a missing checkpoint, or a checkpoint of another algorithm or
         observation size.
+    MissingExtraError
+        The ``[train]`` extra (torch, stable-baselines3, ...) is not installed.
     """
+    require_extra("train", "graspgait_env.agents.train.train")
     set_torch_threads(config.torch_threads)
     seed_everything(config.seed)
     wall_before = 0.0

@@ -91,7 +91,7 @@ class LegalActionWrapper(gym.Wrapper):
     ## Arguments
 
     ``LegalActionWrapper(env)``: a GraspGait env (any id; wrapped or not). RL Zoo:
-    ``env_wrapper: agents.wrappers.LegalActionWrapper`` (configs/rlzoo/ppo.yml).
+    ``env_wrapper: graspgait_env.agents.wrappers.LegalActionWrapper`` (configs/rlzoo/ppo.yml).
 
     ## Version History
 
@@ -151,7 +151,8 @@ class SolvableStartWrapper(gym.Wrapper):
 
     A gait exists when the rule-based method (thesis 6.5, milliseconds) finds one, else
     when the exact planner (:func:`graspgait_env.planners.exact.optimal_gait`) does; the
-    answers are cached per grasp map and start (:class:`agents.evaluate.ReferenceGaits`).
+    answers are cached per grasp map and start
+    (:class:`graspgait_env.agents.evaluate.ReferenceGaits`).
 
     ## Action Space, Observation Space, Rewards, Episode End
 
@@ -180,7 +181,7 @@ class SolvableStartWrapper(gym.Wrapper):
 
     def __init__(self, env: gym.Env) -> None:
         super().__init__(env)
-        from agents.evaluate import ReferenceGaits
+        from graspgait_env.agents.evaluate import ReferenceGaits
 
         self._refs = ReferenceGaits()
 
@@ -215,7 +216,8 @@ def rule_based_starts(model: Any, turn_deg: float) -> list[Any]:
     8 s for the hexagon's 582 starts under the hand's contact model, of which 35
     qualify) and cached.
     """
-    from agents.evaluate import ReferenceGaits
+    from graspgait_env.agents.evaluate import ReferenceGaits
+
     from graspgait_env.planners.rule_based import rule_based
 
     key = (ReferenceGaits().model_key(model), model.turn_steps(turn_deg))

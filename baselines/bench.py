@@ -200,7 +200,7 @@ def markdown_report(cases: list[BenchCase]) -> str:
 
     The planners only: learned agents' runs (planner ``"agent:NAME"``) are left out of
     these tables (some run from other starts under the hand's contact model); they have
-    their own table (``agents.bench.agents_markdown``)."""
+    their own table (``graspgait_env.agents.bench.agents_markdown``)."""
     cases = [c for c in cases if not c.planner.startswith("agent:")]
     summ = summarize(cases)
     order = list(DEFAULT_PLANNERS)

@@ -7,7 +7,7 @@ task per argument tuple with a progress bar, keeps the results in submission ord
 reports a failed task (its index and error) instead of losing the others.
 
 - :func:`bench_on_ray`: ``graspgait bench --ray``: one task per (object, mu) cell, each
-  running :func:`baselines.bench.run_bench` on that cell exactly as the serial bench
+  running :func:`graspgait_env.baselines.bench.run_bench` on that cell exactly as the serial bench
   does, so the cases (and the summary) are the serial ones; only wall times differ.
 - :func:`campaign`: the perturbed MuJoCo campaign of thesis 7.5 (``graspgait simulate
   PLAN --perturb random --seeds 0-9 [--ray]``): one run of
@@ -149,7 +149,7 @@ def run_tasks(fn: Callable[..., Any], calls: Sequence[tuple], labels: Sequence[s
 def _bench_cell(obj: str, mu: float, planners: Sequence[str], starts: int,
                 turn_deg: float, planner_kwargs: dict | None) -> list[Any]:
     """The serial bench on one (object, mu) cell (runs in a Ray worker)."""
-    from baselines.bench import run_bench
+    from graspgait_env.baselines.bench import run_bench
 
     return run_bench(objects=[obj], mus=[mu], planners=list(planners), starts=starts,
                      turn_deg=turn_deg, progress=False, planner_kwargs=planner_kwargs)
@@ -159,17 +159,17 @@ def bench_on_ray(objects: Sequence[str], mus: Sequence[float], planners: Sequenc
                  starts: int = 10, turn_deg: float = 360.0, *, address: str | None = None,
                  progress: bool = True, planner_kwargs: dict | None = None
                  ) -> tuple[list[Any], list[TaskFailure]]:
-    """:func:`baselines.bench.run_bench` with one Ray task per (object, mu) cell.
+    """:func:`graspgait_env.baselines.bench.run_bench` with one Ray task per (object, mu) cell.
 
     The cells run the serial bench's own code, and their cases are concatenated in the
     serial order (objects, then mus), so the cases and
-    :func:`~baselines.bench.markdown_report` are those of ``run_bench`` with the same
+    :func:`~graspgait_env.baselines.bench.markdown_report` are those of ``run_bench`` with the same
     arguments, wall times aside. A failed cell is reported and the others kept.
 
     Returns
     -------
     cases, failures
-        :class:`~baselines.bench.BenchCase` rows of the cells that ran, and the failed
+        :class:`~graspgait_env.baselines.bench.BenchCase` rows of the cells that ran, and the failed
         cells (label ``"object mu=..."``).
     """
     cells = [(o, float(mu)) for o in objects for mu in mus]

@@ -23,7 +23,7 @@ from graspgait_env.workspace import (
     workspace_map,
 )
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 # `import graspgait_env` registers every Gymnasium id (GraspGait-v0, GraspGaitRandom-v0);
 # registration is skipped when gymnasium is not installed, so the map-level core keeps

@@ -1,4 +1,4 @@
-"""The ``graspgait`` command line (docs/cli.md).
+"""The ``graspgait`` command line.
 
 ::
 
@@ -7,13 +7,19 @@
     graspgait plan OBJECT --mu 0.7 --planner P [--start PHI1,PHI2] [--turn 360] [--json F]
                    [--motion F] [--png F]
     graspgait bench [--objects ...] [--mus 0.8,0.7] [--planners ...] [--starts 10]
-                    [--csv F] [--json F] [--md F]
+                    [--agents shipped|none|NAME,...] [--csv F] [--json F] [--md F] [--png F]
     graspgait simulate PLAN.json [--video F.mp4] [--json F] [--perturb DX,DY,DTH|random]
     graspgait perf [--repeat 100] [--json F]
+    graspgait train CONFIG [--set KEY=VALUE ...] [--seeds 0-4 [--ray [ADDRESS]]]
+    graspgait evaluate MODEL|NAME [--object OBJECT] [--mu MU] [--episodes N] | --list
+    graspgait story [MODEL|NAME] [--object OBJECT] [--start PHI1,PHI2] [--out DIR] | --list
+    graspgait config [KIND [NAME]]
 
-Exit status: 0 on success; 2 on bad input (an argument, a file, a field), with one
-line ``graspgait: error: <message>`` on stderr and no traceback; 1 when a question has
-no answer (:class:`~graspgait_env.errors.NoGaitError`).
+Every subcommand's ``--help`` shows its defaults, examples and, for the long ones, a
+rough duration. Exit status: 0 on success; 2 on bad input (an argument, a file, a
+field) or a missing extra, with one line ``graspgait: error: <message>`` on stderr and
+no traceback; 1 when a question has no answer
+(:class:`~graspgait_env.errors.NoGaitError`).
 
 Subcommands are registered in :data:`SUBCOMMANDS`: each entry is a function that adds
 its parser to the subparsers and sets ``func`` (the handler, ``args -> int``).
@@ -25,6 +31,7 @@ import argparse
 import contextlib
 import math
 import sys
+import textwrap
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -36,11 +43,78 @@ __all__ = ["main", "build_parser", "SUBCOMMANDS"]
 PROG = "graspgait"
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """Help that stands alone: every option with a default shows it (unless its text
+    already says it), descriptions are wrapped paragraphs, and an epilog's indented lines
+    (the examples) keep their line breaks."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if (action.default is None or action.default is False
+                or action.default == argparse.SUPPRESS or "default" in text
+                or (not action.option_strings and action.nargs not in ("?", "*"))):
+            return text
+        return text + " (default: %(default)s)"
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        out = []
+        for para in textwrap.dedent(text).strip("\n").split("\n\n"):
+            if any(line.startswith(" ") for line in para.splitlines()):
+                out.append("\n".join(indent + line for line in para.splitlines()))
+            else:
+                out.append(textwrap.fill(" ".join(para.split()), width,
+                                         initial_indent=indent, subsequent_indent=indent))
+        return "\n\n".join(out)
+
+
+def _epilog(examples: Sequence[str], duration: str | None = None, notes: str = "") -> str:
+    """An epilog: ``examples:`` (one command per line), then notes and ``takes about``."""
+    text = "examples:\n" + "\n".join(f"  {PROG} {e}" for e in examples)
+    if notes:
+        text += "\n\n" + notes
+    if duration:
+        text += f"\n\ntakes about: {duration} (2-core machine, one torch thread)"
+    return text
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line usage errors: ``graspgait map: error: ...; see --help``."""
+    """argparse with one-line usage errors: ``graspgait map: error: ...; see --help``, and
+    :class:`_HelpFormatter` for every (sub)parser."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", _HelpFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message}; see `{self.prog} --help`\n")
+
+
+def _require(extra: str, what: str) -> None:
+    """Refuse, in one line naming the extra to install, a command whose extra is missing;
+    before the work starts, not when it reaches the first import."""
+    from graspgait_env.extras import require_extra
+
+    require_extra(extra, what)
+
+
+def _require_ray(args: argparse.Namespace, what: str) -> None:
+    if getattr(args, "ray", None) is not None:
+        _require("ray", f"{what} --ray")
+
+
+def _print_shipped() -> int:
+    """``--list``: the shipped agents, one line each (name, env, latest evaluation)."""
+    from graspgait_env.agents.card import describe_shipped, shipped_models_dir
+
+    rows = describe_shipped()
+    if not rows:
+        print("no shipped agents in this install")
+        return 0
+    width = max(len(name) for name, _ in rows)
+    for name, line in rows:
+        print(f"{name:<{width}}  {line}")
+    print(f"(models and their cards NAME.zip, NAME.json, NAME.md in {shipped_models_dir()})")
+    return 0
 
 
 def _input_error(flag: str, exc: ValueError) -> GraspGaitInputError:
@@ -152,13 +226,20 @@ def _add_map(sub: argparse._SubParsersAction) -> None:
                        description="Compute the grasp map of OBJECT at friction MU; print a "
                        "summary, optionally save the map (.npy) and a figure (.png): object "
                        "with normals, grasp map, extended map with the hand's finger pair "
-                       "boxes at object angle THETA (thesis figs. 3.1, 4.5, 6.1).")
+                       "boxes at object angle THETA (thesis figs. 3.1, 4.5, 6.1).",
+                       epilog=_epilog(["map ellipse --mu 0.7 --png ellipse_map.png",
+                                       "map pentagon --mu 0.5 --theta 30 --hand wide "
+                                       "--npy pentagon.npy",
+                                       "map my_shape.yaml --mu 0.7 --png my_map.png"],
+                                      notes="Write your own object YAML from a bundled one: "
+                                      f"`{PROG} config objects pentagon > my_shape.yaml`."))
     p.add_argument("object", metavar="OBJECT", help=_object_help())
     p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
     p.add_argument("--n", type=int, default=180,
                    help="contacts on the contour (default 180: 2 deg)")
     p.add_argument("--theta", type=float, default=0.0,
-                   help="object angle (deg) at which the finger pair boxes are drawn")
+                   help="object angle (deg) at which the finger pair boxes are drawn "
+                   "(default 0)")
     p.add_argument("--hand", default=None,
                    help=_hand_help())
     p.add_argument("--png", metavar="FILE", help="write the figure here")
@@ -193,8 +274,12 @@ def _add_sweep(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("sweep", help="grasp maps over eccentricity or smoothness and friction",
                        description="Grasp maps of ellipses of decreasing eccentricity, or of a "
                        "circle and polygons of decreasing smoothness, for mu = .9 .. .1 "
-                       "(thesis figs. 3.8-3.11).")
-    p.add_argument("kind", choices=("eccentricity", "smoothness"))
+                       "(thesis figs. 3.8-3.11).",
+                       epilog=_epilog(["sweep eccentricity --png ecc.png",
+                                       "sweep smoothness --n 90"], duration="10 s at n 180"))
+    p.add_argument("kind", choices=("eccentricity", "smoothness"),
+                   help="ellipses of decreasing eccentricity, or polygons of decreasing "
+                   "smoothness")
     p.add_argument("--n", type=int, default=180, help="contacts on the contour (default 180)")
     p.add_argument("--png", metavar="FILE", help="figure path (default sweep_KIND.png)")
     p.set_defaults(func=_cmd_sweep)
@@ -214,6 +299,9 @@ def _cmd_perf(args: argparse.Namespace) -> int:
     print()
     print(perf.markdown_table(rows))
     failed = [r.name for r in rows if r.passed is False]
+    for mod, extra in perf.skipped_benchmark_modules():
+        print(f"skipped {mod}: needs the [{extra}] extra (pip install "
+              f"'graspgait_env[{extra}]')")
     print()
     print(f"FAIL: {', '.join(failed)}" if failed else "all targets PASS")
     if args.json:
@@ -224,9 +312,19 @@ def _cmd_perf(args: argparse.Namespace) -> int:
 
 def _add_perf(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("perf", help="measure the performance targets",
-                       description="Time the grasp map against its targets and print a "
-                       "Markdown table (exit 0 even when a target FAILs).")
-    p.add_argument("--repeat", type=int, default=100, help="timed repeats (median; default 100)")
+                       description="Time every registered benchmark on this machine and print "
+                       "one Markdown table of rows (measured figure, target, PASS/FAIL): the "
+                       "grasp map (vectorized, against a per-cell loop in the same process), "
+                       "the planners, the Gymnasium envs (steps/s of GraspGait-v0 against "
+                       "CartPole-v1 in the same process, and the batched env against the "
+                       "single one), rendering, the MuJoCo hand (a 360 deg gait's wall time, "
+                       "physics steps/s) and, with the [train] extra, SB3 training "
+                       "throughput. Exit 0 even when a target FAILs: a missed target is "
+                       "reported, not an error.",
+                       epilog=_epilog(["perf", "perf --repeat 20 --json perf.json"],
+                                      duration="90 s with the defaults"))
+    p.add_argument("--repeat", type=int, default=100,
+                   help="timed repeats of the fast rows (their median; default 100)")
     p.add_argument("--json", metavar="FILE", help="also write the rows as JSON")
     p.set_defaults(func=_cmd_perf)
 
@@ -377,7 +475,20 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("plan", help="plan a grasp gait (thesis ch. 5-6)",
                        description="Plan a gait turning OBJECT by TURN degrees with one of "
                        "the thesis's planners or the exact optimum; exit 0 with a plan, 1 "
-                       "when no gait exists (with a diagnosis), 2 for bad input.")
+                       "when no gait exists (with a diagnosis), 2 for bad input.",
+                       epilog=_epilog(
+                           ["plan pentagon --mu 0.7 --planner rule --json plan.json",
+                            "plan pentagon --mu 0.7 --planner optimal --start 50,270 "
+                            "--point-contacts --png gait.png",
+                            "plan my_shape.yaml --mu 0.5 --planner best-first --turn 180"],
+                           notes="The plan JSON: {\"object\", \"mu\", \"workspaces_deg\": "
+                           "[[lo, hi] per finger], \"steps\": [{\"op\": \"grasp\", "
+                           "\"contacts\": {\"1\": 50.0, \"3\": 270.0}}, {\"op\": \"rotate\", "
+                           "\"delta\": 40.0}, {\"op\": \"regrasp\", \"contacts\": {...}}, ...], "
+                           "\"stats\", \"contact_model\"}: fingers numbered 1-3 as strings, "
+                           "contact angles phi in degrees in the object frame, rotations in "
+                           "degrees, counter-clockwise positive. Every planner writes it; "
+                           f"`{PROG} simulate` reads it."))
     p.add_argument("object", metavar="OBJECT", help=_object_help())
     p.add_argument("--mu", type=float, required=True, help="Coulomb friction coefficient (> 0)")
     p.add_argument("--planner", required=True, choices=list(PLANNERS), metavar="P",
@@ -399,14 +510,14 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
                    "Tables 1 and 6.1) instead of the simulated hand's ball tips; "
                    "`graspgait simulate` warns about such plans")
     p.add_argument("--sim-config", metavar="SIM.yaml", default=None,
-                   help="the simulation config whose hand the plan is for (default "
-                   "configs/sim/default.yaml): tip radius, table friction, rotation "
-                   "acceleration and grip set the contact model")
+                   help="the simulation config whose hand the plan is for (default: the "
+                   f"bundled one, `{PROG} config sim default`): tip radius, table friction, "
+                   "rotation acceleration and grip set the contact model")
     p.add_argument("--verbose", action="store_true",
                    help="when no gait exists, print the planner's account and the whole "
                    "diagnosis (grasp map, prototype conditions, each start tried) instead "
                    "of three lines")
-    p.add_argument("--json", metavar="FILE", help="write the plan JSON (docs/formats.md)")
+    p.add_argument("--json", metavar="FILE", help="write the plan JSON (its format: below)")
     p.add_argument("--motion", metavar="FILE", help="write the thesis's motion_file (7.4.1)")
     p.add_argument("--png", metavar="FILE", help="draw the gait over the maps")
     p.set_defaults(func=_cmd_plan)
@@ -437,11 +548,11 @@ def _bench_cases(args: argparse.Namespace, objects: list[str], mus: list[float],
                  planners: list[str]) -> list:
     """The bench's cases, serially or (``--ray``) one Ray task per object and mu; a failed
     cell is reported on stderr (the exit status becomes 1) and the others kept."""
-    from baselines import bench
+    from graspgait_env.baselines import bench
 
     if args.ray is None:
         return bench.run_bench(objects, mus, planners, args.starts)
-    from baselines.scale_out import bench_on_ray
+    from graspgait_env.baselines.scale_out import bench_on_ray
 
     cases, failures = bench_on_ray(objects, mus, planners, args.starts, address=args.ray)
     for f in failures:
@@ -451,7 +562,7 @@ def _bench_cases(args: argparse.Namespace, objects: list[str], mus: list[float],
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from baselines import bench
+    from graspgait_env.baselines import bench
     from graspgait_env.planners.registry import get_planner
 
     mus = [_check_mu(m) for m in _csv_list("--mus", args.mus, float)]
@@ -467,10 +578,14 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     for o in objects:
         load_object(o)  # refuse bad names before the long run
     _check_outputs(args, {"png": _figure_suffixes()})
-    agents = _bench_agents(args.agents)  # agents.bench; loaded before the long run
+    _require_ray(args, "graspgait bench")
+    if args.agents != "none":
+        _require("train", f"graspgait bench --agents {args.agents} (use --agents none for the "
+                 "planners alone)")
+    agents = _bench_agents(args.agents)  # graspgait_env.agents.bench; loaded before the long run
     with contextlib.ExitStack() as stack:
         if args.ray is not None:  # one Ray session for the planners' and the agents' tasks
-            from baselines.scale_out import ray_session
+            from graspgait_env.baselines.scale_out import ray_session
 
             stack.enter_context(ray_session(args.ray))
         cases = _bench_cases(args, objects, mus, planners)
@@ -489,7 +604,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         _write_output("--md", args.md, lambda: write_text_atomic(args.md, report + "\n"))
         print(f"wrote {args.md}")
     if args.png:
-        from agents.bench import plot_bench
+        from graspgait_env.agents.bench import plot_bench
 
         _write_output("--png", args.png, lambda: plot_bench(cases, args.png))
         print(f"wrote {args.png}")
@@ -500,30 +615,41 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="regenerate the thesis's Tables 1 and 6.1",
                        description="Run the planners on the thesis's four objects (fig. 5.3), "
                        "10 initial grasps each, mu 0.8 and 0.7, 90-degree workspaces; print "
-                       "Tables 1 and 6.1 in Markdown beside the thesis's figures.")
+                       "Tables 1 and 6.1 in Markdown beside the thesis's figures, then the "
+                       "shipped agents from the same starts (needs the [train] extra; "
+                       "--agents none without it).",
+                       epilog=_epilog(["bench", "bench --agents none --md tables.md",
+                                       "bench --agents shipped --objects pentagon --starts 2",
+                                       "bench --ray --json bench.json --png bench.png"],
+                                      duration="2.5 min with the defaults (20 s planners, "
+                                      "the rest agents); seconds with --starts 2"))
     p.add_argument("--objects", default="circle,ellipse,pentagon,hexagon",
                    help="comma-separated objects (default the thesis's four)")
-    p.add_argument("--mus", default="0.8,0.7", help="comma-separated friction coefficients")
+    p.add_argument("--mus", default="0.8,0.7", help="comma-separated friction coefficients "
+                   "(default 0.8,0.7)")
     p.add_argument("--planners", default="best-first,best-first-newest,rule,modified,optimal",
                    help="comma-separated planner names (default: best-first with ties to the "
                    "oldest and to the newest node, rule, modified, optimal)")
-    p.add_argument("--starts", type=int, default=10, help="initial grasps per object and mu")
+    p.add_argument("--starts", type=int, default=10,
+                   help="initial grasps per object and mu (default 10)")
     _add_ray_option(p, "run one Ray task per object and mu; same tables as the serial bench")
     p.add_argument("--csv", metavar="FILE", help="write one row per run")
     p.add_argument("--json", metavar="FILE", help="write runs and summary")
     p.add_argument("--md", metavar="FILE", help="write the Markdown tables")
     p.add_argument("--agents", default="shipped", metavar="shipped|none|NAME,...",
-                   help="learned agents to run from the same starts: the shipped models "
-                   "present in agents/models/ (default), none, or names / .zip paths")
+                   help="learned agents to run from the same starts: every shipped agent "
+                   f"(default; `{PROG} evaluate --list` names them), none, or shipped "
+                   "names / .zip paths")
     p.add_argument("--png", metavar="FILE", help="plot regrasps per 360 deg of every method")
     p.set_defaults(func=_cmd_bench)
 
 
 def _bench_agents(spec: str) -> Callable[..., tuple[list, str]]:
-    """The agents' part of ``graspgait bench`` (agents.bench): ``run(args, cases, objects,
+    """The agents' part of ``graspgait bench`` (graspgait_env.agents.bench): ``run(args, cases,
+    objects,
     mus, starts) -> (cases + the agents' runs, their Markdown section)``; with ``--ray``
     one Ray task per agent, object and mu (a failed one is reported, the others kept)."""
-    from agents.bench import agents_markdown, find_agents, run_agent_bench
+    from graspgait_env.agents.bench import agents_markdown, find_agents, run_agent_bench
 
     agents, notes = find_agents(spec)
 
@@ -534,7 +660,7 @@ def _bench_agents(spec: str) -> Callable[..., tuple[list, str]]:
         if args.ray is None:
             runs = run_agent_bench(agents, objects, mus, starts)
         else:
-            from agents.ray_train import bench_agents_on_ray
+            from graspgait_env.agents.ray_train import bench_agents_on_ray
 
             runs, failures = bench_agents_on_ray(agents, objects, mus, starts,
                                                  address=args.ray)
@@ -555,6 +681,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from graspgait_env.sim.simulate import simulate_command
 
     _check_outputs(args, {"json": (".json",)})  # --video: simulate_command checks it
+    _require_ray(args, "graspgait simulate")
+    if args.video is not None:
+        _require("video", "graspgait simulate --video")
     if args.seeds is not None or args.ray is not None:
         return _simulate_campaign(args)
     return simulate_command(args.plan, video=args.video, seed=args.seed, perturb=args.perturb,
@@ -567,7 +696,7 @@ def _simulate_campaign(args: argparse.Namespace) -> int:
     when every run succeeds, 1 otherwise (a failed run is reported, the others kept)."""
     import json
 
-    from baselines.scale_out import campaign, parse_seeds, summarize_campaign
+    from graspgait_env.baselines.scale_out import campaign, parse_seeds, summarize_campaign
     from graspgait_env.plan import Plan
 
     if args.video is not None or args.perturb not in (None, "random"):
@@ -603,19 +732,29 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:
                        "the thesis controller (trajectory planner, PD servo, grip-force and "
                        "friction-cone check, object localizer) and report success, rotation, "
                        "final errors, drops, slips, sim and wall time. Exit 0 when the gait "
-                       "succeeds, 1 when the hand fails it, 2 for bad input.")
+                       "succeeds, 1 when the hand fails it, 2 for bad input.",
+                       epilog=_epilog(["simulate plan.json   # after: graspgait plan "
+                                       "ellipse --mu 0.7 --planner optimal --json plan.json",
+                                       "simulate plan.json --video gait.mp4   # needs "
+                                       "the [video] extra",
+                                       "simulate plan.json --perturb 0.003,-0.002,2",
+                                       "simulate plan.json --seeds 0-9 --ray"],
+                                      duration="1 s per run of a 360 deg gait (15 s with "
+                                      "--video); --seeds 0-9 about 6 s"))
     p.add_argument("plan", metavar="PLAN.json", help="a plan written by `graspgait plan`")
-    p.add_argument("--video", metavar="FILE.mp4", help="render a video (headless, EGL)")
+    p.add_argument("--video", metavar="FILE.mp4", help="render a video (headless, EGL; the "
+                   "[video] extra)")
     p.add_argument("--json", metavar="FILE", help="write the result JSON")
     p.add_argument("--perturb", metavar="DX,DY,DTH|random",
                    help="initial object pose error: metres, metres, degrees; or 'random' "
                    "(up to 6 mm and 5 deg, from --seed)")
-    p.add_argument("--seed", type=int, default=0, help="seed for --perturb random")
+    p.add_argument("--seed", type=int, default=0, help="seed for --perturb random "
+                   "(default 0)")
     p.add_argument("--seeds", metavar="SEEDS", help="the perturbed campaign: one run per seed "
                    "(e.g. 0-9), each from a random pose error drawn from it; a table and tally")
     _add_ray_option(p, "run the campaign's runs as Ray tasks; same results")
-    p.add_argument("--config", metavar="SIM.yaml", help="simulation config "
-                   "(default configs/sim/default.yaml)")
+    p.add_argument("--config", metavar="SIM.yaml", help="simulation config YAML (default: "
+                   f"the bundled one; `{PROG} config sim default > my_sim.yaml` starts yours)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_simulate)
 
@@ -624,8 +763,10 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from agents.config import load_train_config
-    from agents.train import train
+    _require("train", "graspgait train")
+    _require_ray(args, "graspgait train")
+    from graspgait_env.agents.config import load_train_config
+    from graspgait_env.agents.train import train
 
     config = load_train_config(args.config, args.set or [])
     if args.seeds is not None or args.ray is not None:
@@ -648,8 +789,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _train_seeds(args: argparse.Namespace, config) -> int:
     """``--seeds`` / ``--ray``: one run per seed (Ray Tune trials with ``--ray``); a table
     of the final evaluations; exit 1 when a seed failed (the others are kept)."""
-    from agents.ray_train import train_seeds
-    from baselines.scale_out import parse_seeds
+    from graspgait_env.agents.ray_train import train_seeds
+    from graspgait_env.baselines.scale_out import parse_seeds
 
     if args.resume is not None or args.run_dir is not None:
         raise GraspGaitInputError("--seeds/--ray with --resume/--run-dir: each seed gets its "
@@ -679,9 +820,18 @@ def _add_train(sub: argparse._SubParsersAction) -> None:
                        description="Train an agent on a GraspGait env: progress bar, TensorBoard "
                        "logs, periodic evaluation against the exact optimum and the rule-based "
                        "gait, checkpoints; the run's folder is runs/{env}-{config}-s{seed}-{time}"
-                       " and the model is saved there as model.zip with its card model.json.")
+                       " and the model is saved there as model.zip with its card model.json. "
+                       "Needs the [train] extra.",
+                       epilog=_epilog(["train smoke --run-dir smoke_run",
+                                       "train ellipse --set total_timesteps=100000",
+                                       "train my_config.yaml --seeds 0-4 --ray",
+                                       "config train ellipse > my_config.yaml"],
+                                      duration="seconds for smoke; 4-10 min for the bundled "
+                                      "thesis-object configs, 30 min for random; --seeds "
+                                      "runs one per seed (in parallel with --ray)"))
     p.add_argument("config", metavar="CONFIG", help="a bundled training config "
-                   f"({', '.join(bundled_names('train'))}) or a YAML path")
+                   f"({', '.join(bundled_names('train'))}; `{PROG} config train NAME` prints "
+                   "one) or a YAML path")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="replace a config field (YAML value; dots reach into env_kwargs, e.g. "
                    "env_kwargs.mu=0.8); repeatable")
@@ -700,8 +850,15 @@ def _add_train(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from agents.config import apply_overrides
-    from agents.evaluate import evaluate, format_evaluation, write_evaluation
+    if args.list:
+        return _print_shipped()
+    if args.model is None:
+        raise GraspGaitInputError("MODEL missing: give a shipped agent's name (e.g. ellipse; "
+                                  f"`{PROG} evaluate --list` names them) or a model zip path")
+    _require("train", "graspgait evaluate")
+    _require_ray(args, "graspgait evaluate")
+    from graspgait_env.agents.config import apply_overrides
+    from graspgait_env.agents.evaluate import evaluate, format_evaluation, write_evaluation
 
     _check_outputs(args, {"json": (".json",)})
     mu = None if args.mu is None else _check_mu(args.mu)
@@ -715,7 +872,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         raise GraspGaitInputError("--audit with --ray: the audit runs in this process; "
                                   "drop --ray (or --audit)")
     if args.ray is not None:
-        from agents.ray_train import evaluate_on_ray
+        from graspgait_env.agents.ray_train import evaluate_on_ray
 
         result = evaluate_on_ray(args.model, env_id=args.env, object=args.object, mu=mu,
                                  episodes=args.episodes, seed=args.seed, env_overrides=env_set,
@@ -737,14 +894,26 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                        "rate (over all episodes and over the starts from which a gait exists) "
                        "and its regrasps beside the exact optimum's and the rule-based gait's "
                        "from the same starts, under the same contact model. By default the env "
-                       "settings the model was trained with (from its card).")
-    p.add_argument("model", metavar="MODEL", help="a model zip (runs/<run>/model.zip, "
-                   "agents/models/ellipse.zip)")
+                       "settings the model was trained with (from its card). Needs the [train] "
+                       "extra.",
+                       epilog=_epilog(["evaluate --list",
+                                       "evaluate ellipse --episodes 20",
+                                       "evaluate random --object my_shape.yaml --mu 0.5",
+                                       "evaluate runs/RUN/model.zip --json eval.json",
+                                       "evaluate hexagon --env GraspGaitMujoco-v1 --episodes 5"],
+                                      duration="5-60 s for 100 episodes at map level (the "
+                                      "look-ahead of random plays them one by one); about "
+                                      "2 s per episode on the MuJoCo hand"))
+    p.add_argument("model", metavar="MODEL", nargs="?",
+                   help="a shipped agent's name (see --list) or a model zip saved by "
+                   f"`{PROG} train` (RUN/model.zip, its card RUN/model.json beside it)")
+    p.add_argument("--list", action="store_true", help="name the shipped agents and exit")
     p.add_argument("--env", metavar="ID", help="GraspGait-v0, GraspGaitRandom-v0 or "
                    "GraspGaitMujoco-v1 (default: the training env)")
     p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
     p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
-    p.add_argument("--episodes", type=int, default=100, help="episodes (default 100)")
+    p.add_argument("--episodes", type=int, default=100, help="episodes (reset seeds SEED .. "
+                   "SEED + N - 1; default 100)")
     p.add_argument("--seed", type=int, default=0, help="first reset seed (default 0)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="an env keyword argument (YAML value), e.g. bundled_fraction=0; "
@@ -752,7 +921,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="FILE", help="write the result JSON (per-episode records)")
     p.add_argument("--audit", action="store_true",
                    help="price every move against the optimum: where the regrasps beyond "
-                   "it go (idle regrasps, losing regrasps, losing rotations; agents.audit)")
+                   "it go (idle regrasps, losing regrasps, losing rotations)")
     _add_ray_option(p, "split the episodes over Ray tasks; same result as serially")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_evaluate)
@@ -762,13 +931,14 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_story(args: argparse.Namespace) -> int:
-    from agents.bench import shipped_models_dir
-    from agents.story import gait_model_of, tell_story
+    if args.list:
+        return _print_shipped()
+    _require("train", "graspgait story")
+    from graspgait_env.agents.card import resolve_model
+    from graspgait_env.agents.story import gait_model_of, tell_story
 
     mu = None if args.mu is None else _check_mu(args.mu)
-    # a shipped agent's name (agents/models/NAME.zip) or a path
-    model = (args.model if args.model.endswith(".zip")
-             else str(shipped_models_dir() / f"{args.model}.zip"))
+    model = str(resolve_model(args.model))  # a shipped agent's name or a path
     start = (None if args.start is None
              else _parse_start(args.start, gait_model_of(model, args.object, mu)))
     result = tell_story(model, args.out, start=start, object=args.object, mu=mu)
@@ -788,16 +958,74 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
                        "on the extended grasp map with a comparison table, each written as a "
                        "plan JSON (replay the learned one on the MuJoCo hand with `graspgait "
                        "simulate OUT/OBJECT_learned_plan.json --video F.mp4`). Exit 1 when the "
-                       "agent does not reach the turn.")
+                       "agent does not reach the turn. Needs the [train] extra.",
+                       epilog=_epilog(["story", "story hexagon --out story",
+                                       "story random --object my_shape.yaml --mu 0.6",
+                                       "story ellipse --start 50,270"],
+                                      duration="5-20 s"))
     p.add_argument("model", metavar="MODEL", nargs="?", default="ellipse",
-                   help="a shipped agent (circle, ellipse, pentagon, hexagon, random: "
-                   "agents/models/NAME.zip) or a model zip with its card (default ellipse)")
+                   help="a shipped agent's name (see --list) or a model zip with its card "
+                   "(default ellipse)")
+    p.add_argument("--list", action="store_true", help="name the shipped agents and exit")
     p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
     p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
     p.add_argument("--start", metavar="PHI1,PHI2", help="start contacts at theta = 0 (deg, "
                    "object frame; default: the first of 24 spread starts with a gait)")
     p.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
     p.set_defaults(func=_cmd_story)
+
+
+# --- config ---------------------------------------------------------------------------
+
+
+def _cmd_config(args: argparse.Namespace) -> int:
+    from graspgait_env.resources import KINDS, bundled_file, bundled_names, config_dir
+
+    if args.kind is None:
+        for kind in KINDS:
+            print(f"{kind:<8} {', '.join(bundled_names(kind))}")
+        print(f"(`{PROG} config KIND NAME` prints one; bundled in {config_dir('objects').parent})")
+        return 0
+    if args.kind not in KINDS:
+        raise GraspGaitInputError(f"KIND {args.kind!r}: must be one of {', '.join(KINDS)}")
+    if args.name is None:
+        for name in bundled_names(args.kind):
+            print(name)
+        return 0
+    path = bundled_file(args.kind, args.name)
+    if path is None:
+        import difflib
+
+        names = bundled_names(args.kind)
+        near = difflib.get_close_matches(args.name, names, n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise GraspGaitInputError(f"NAME {args.name!r}: no bundled {args.kind} file of that "
+                                  f"name; {hint}give one of {', '.join(names)}")
+    if args.path:
+        print(path)
+    else:
+        sys.stdout.write(path.read_text(encoding="utf-8"))
+    return 0
+
+
+def _add_config(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("config", help="list or print the bundled YAML files",
+                       description="The YAML files that ship with the package: objects, "
+                       "hands, the simulation config, the training configs and RL Zoo's "
+                       "hyper-parameters. Without KIND, list every kind and its names; with "
+                       "KIND, list its names; with NAME, print the file (redirect it to start "
+                       "your own).",
+                       epilog=_epilog(["config", "config objects",
+                                       "config objects pentagon > my_shape.yaml",
+                                       "config sim default > my_sim.yaml",
+                                       "config train ellipse > my_config.yaml",
+                                       "config rlzoo ppo --path"]))
+    p.add_argument("kind", metavar="KIND", nargs="?",
+                   help="objects, hands, sim, train or rlzoo")
+    p.add_argument("name", metavar="NAME", nargs="?", help="a bundled file's name")
+    p.add_argument("--path", action="store_true",
+                   help="print the installed file's path instead of its text")
+    p.set_defaults(func=_cmd_config)
 
 
 # --- registry -------------------------------------------------------------------------
@@ -814,6 +1042,7 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_train,
     _add_evaluate,
     _add_story,
+    _add_config,
 ]
 
 
@@ -827,10 +1056,11 @@ def build_parser() -> argparse.ArgumentParser:
         prog=PROG,
         description="Grasp gaits for planar object manipulation (Leveroni, MIT 1997): "
         "grasp maps, workspace maps, gaits, and their execution on a simulated hand.",
-        epilog=f"bundled objects (OBJECT): {', '.join(bundled_objects())}; or the path of an "
-        "object YAML (docs/formats.md). "
+        epilog=f"Bundled objects (OBJECT): {', '.join(bundled_objects())}; or the path of an "
+        f"object YAML (`{PROG} config objects NAME` prints a bundled one to start from). "
         f"Bundled hands (--hand): {', '.join(bundled_hands())}; or a hand YAML path. "
-        "Exit status: 0 success, 1 no gait exists or the hand fails, 2 bad input.",
+        "Exit status: 0 success, 1 no gait exists or the hand fails, 2 bad input or a "
+        f"missing extra. `{PROG} COMMAND --help` gives each command's defaults and examples.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -847,7 +1077,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``graspgait`` with ``argv`` (default ``sys.argv[1:]``); return the exit status.
 
     Bad input (:class:`~graspgait_env.errors.GraspGaitInputError`, which includes every
-    :class:`~graspgait_env.errors.ConfigError`) prints one line and returns 2; a
+    :class:`~graspgait_env.errors.ConfigError` and
+    :class:`~graspgait_env.extras.MissingExtraError`) prints one line and returns 2; so
+    does a module of an extra that is not installed; a
     :class:`~graspgait_env.errors.NoGaitError` prints one line and returns 1. Usage
     errors (and ``--help``) print as argparse does; their exit status is returned
     rather than raised, so in-process callers always get an int.
@@ -859,6 +1091,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     try:
         return int(args.func(args))
+    except ModuleNotFoundError as exc:  # an extra's module, reached past the checks above
+        from graspgait_env.extras import MissingExtraError, extra_for_module
+
+        extra = extra_for_module(exc.name or "")
+        if extra is None:
+            raise
+        _error(str(MissingExtraError(extra, f"{PROG} {args.command}", [exc.name])))
+        return 2
     except GraspGaitInputError as exc:
         _error(str(exc))
         return 2

@@ -360,7 +360,7 @@ def hand_contact_model(shape: Shape | str, sim_config: Any = None, *,
         if isinstance(x, bool) or not isinstance(x, (int, float)) or not (
                 math.isfinite(x) and x >= 0) or (k != "table_mu" and x == 0):
             raise GraspGaitInputError(f"sim config {k}={x!r}: give a finite number > 0 "
-                                      "(configs/sim/default.yaml)")
+                                      "(the bundled values: `graspgait config sim default`)")
     m = mass_kg if mass_kg is not None else (v["object_mass"] or file_mass)
     rho = float(v["tip_radius"])
     inertia = polar_moment_of_inertia(obj, m)

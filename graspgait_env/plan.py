@@ -46,6 +46,10 @@ from graspgait_env.objects import load_object
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand
 
+# Where a user reads the plan format: in the installed command's help (a clone's docs are
+# not on a user's machine).
+PLAN_FORMAT_HINT = "the plan format: `graspgait plan --help`"
+
 __all__ = [
     "Plan",
     "PlanViolation",
@@ -125,11 +129,11 @@ class Plan:
         """
         def bad(field_: str, value: Any, want: str) -> GraspGaitInputError:
             return GraspGaitInputError(
-                f"{source}: field '{field_}'={value!r}: {want} (see docs/formats.md)")
+                f"{source}: field '{field_}'={value!r}: {want} ({PLAN_FORMAT_HINT})")
 
         if not isinstance(d, dict):
             raise GraspGaitInputError(f"{source}: a plan must be a JSON object "
-                                      "(see docs/formats.md)")
+                                      f"({PLAN_FORMAT_HINT})")
         known = ("object", "mu", "workspaces_deg", "steps", "stats", "contact_model")
         for key in d:
             if key not in known:
@@ -137,7 +141,7 @@ class Plan:
         for key in known[:4]:
             if key not in d:
                 raise GraspGaitInputError(
-                    f"{source}: field '{key}' missing; add it (see docs/formats.md)")
+                    f"{source}: field '{key}' missing; add it ({PLAN_FORMAT_HINT})")
         if not isinstance(d["object"], str) or not d["object"].strip():
             raise bad("object", d["object"], "give a bundled object name or an object YAML path")
         mu = d["mu"]
@@ -187,7 +191,7 @@ class Plan:
             try:
                 cm = ContactModel.from_json(cm, "contact_model").to_json()
             except GraspGaitInputError as exc:
-                raise GraspGaitInputError(f"{source}: {exc} (see docs/formats.md)") from None
+                raise GraspGaitInputError(f"{source}: {exc} ({PLAN_FORMAT_HINT})") from None
         return cls(d["object"], float(mu), [[float(x) for x in w] for w in ws],
                    [dict(st) for st in steps], dict(stats), cm)
 

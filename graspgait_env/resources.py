@@ -7,7 +7,9 @@ reads them from the checkout. Code never builds a path from ``__file__`` to reac
 it asks this module, which goes through :mod:`importlib.resources`.
 
 Layout (``KIND/NAME.yaml``): ``objects/`` (object files), ``hands/`` (hand files),
-``sim/`` (simulation configs), ``train/`` (training configs of ``graspgait train``).
+``sim/`` (simulation configs), ``train/`` (training configs of ``graspgait train``),
+``rlzoo/`` (RL Zoo hyper-parameters, ``NAME.yml`` as RL Zoo names them).
+``graspgait config KIND NAME`` prints one.
 
 >>> from graspgait_env.resources import bundled_names
 >>> "ellipse" in bundled_names("objects")
@@ -22,11 +24,12 @@ from pathlib import Path
 __all__ = ["CONFIG_PACKAGE", "KINDS", "bundled_file", "bundled_names", "config_dir"]
 
 CONFIG_PACKAGE = "graspgait_env.configs"
-KINDS = ("objects", "hands", "sim", "train")
+KINDS = ("objects", "hands", "sim", "train", "rlzoo")
+_SUFFIX = {"rlzoo": ".yml"}  # RL Zoo's own extension; every other kind is .yaml
 
 
 def config_dir(kind: str) -> Path:
-    """The folder of bundled ``kind`` files (``"objects"``, ``"hands"``, ``"sim"``, ``"train"``).
+    """The folder of bundled ``kind`` files (one of :data:`KINDS`).
 
     Raises
     ------
@@ -52,10 +55,11 @@ def config_dir(kind: str) -> Path:
 
 def bundled_names(kind: str) -> list[str]:
     """Names (file stems, sorted) of the bundled ``kind`` files, e.g. ``["circle", ...]``."""
-    return sorted(p.stem for p in config_dir(kind).glob("*.yaml"))
+    return sorted(p.stem for p in config_dir(kind).glob(f"*{_SUFFIX.get(kind, '.yaml')}"))
 
 
 def bundled_file(kind: str, name: str) -> Path | None:
-    """The bundled file ``KIND/NAME.yaml``, or None when there is none of that name."""
-    path = config_dir(kind) / f"{name}.yaml"
+    """The bundled file ``KIND/NAME.yaml`` (``.yml`` for ``rlzoo``), or None when there is
+    none of that name."""
+    path = config_dir(kind) / f"{name}{_SUFFIX.get(kind, '.yaml')}"
     return path if path.is_file() else None

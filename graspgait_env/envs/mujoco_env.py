@@ -57,7 +57,8 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
     As ``GraspGait-v0`` (same ``Box``, same layout, built by the same methods): the
     header and the grasp-map window describe the **commanded** state, so
     :func:`~graspgait_env.envs.map_env.state_from_observation` recovers it exactly
-    (and :class:`baselines.policies.PlannerPolicy` works unchanged). Only the mask entries
+    (and :class:`graspgait_env.baselines.policies.PlannerPolicy` works unchanged). Only the mask
+    entries
     (and ``info["action_mask"]``, ``action_masks()``) use the localizer's estimate:
 
     - the controller's estimated object angle ``θ̂`` (``StepReport.pose_estimate``) is
@@ -75,7 +76,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
       commanded mask is kept (the estimate never makes a false dead end), and after
       any rotation ``k̂ = k`` again. ``info["mask_from_estimate"]`` says whether it
       removed a move. (A policy that ignores the mask, such as
-      :class:`baselines.policies.PlannerPolicy`, may then play an illegal regrasp, a
+      :class:`graspgait_env.baselines.policies.PlannerPolicy`, may then play an illegal regrasp, a
       no-op, again and again: mask-aware agents do not.)
 
     ## Rewards
@@ -189,7 +190,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         if not (sim_config is None or isinstance(sim_config, (SimConfig, str, os.PathLike))):
             raise GraspGaitInputError(
                 f"sim_config={sim_config!r}: give a SimConfig, a path to a sim YAML, or None "
-                "for configs/sim/default.yaml")
+                "for the bundled one (`graspgait config sim default` prints it)")
         self.sim_config = (sim_config if isinstance(sim_config, SimConfig)
                            else load_sim_config(sim_config))
         if config is None and "contact_model" not in fields:

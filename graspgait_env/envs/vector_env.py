@@ -43,7 +43,7 @@ from graspgait_env.envs.registration import MAX_EPISODE_STEPS
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.shapes import Shape
 
-__all__ = ["GraspGaitVectorEnv", "SUPPORTED_FIELDS", "sample_legal_actions"]
+__all__ = ["GraspGaitVectorEnv", "SUPPORTED_FIELDS", "sample_legal_actions", "unsupported_fields"]
 
 # The config fields whose every value the batched step implements. A field added to
 # GraspGaitConfig later is accepted at its default (opt-in fields change nothing there)
@@ -743,15 +743,39 @@ def _window_views(pooled: NDArray[np.float32], s: int, cells: int) -> NDArray[np
     return np.lib.stride_tricks.sliding_window_view(phases, (cells, cells), axis=(2, 3))
 
 
-def _check_supported(cfg: GraspGaitConfig) -> None:
-    """Refuse config fields the batched step does not implement (set off their default)."""
-    for fld in fields(cfg):
+def unsupported_fields(values: GraspGaitConfig | Mapping[str, Any]) -> list[str]:
+    """The config fields set off their default that the batched step does not implement
+    (not in :data:`SUPPORTED_FIELDS`), in the config's order; empty when the batched env
+    reproduces the single env for these settings.
+
+    ``values`` is a :class:`GraspGaitConfig` or the keyword arguments of
+    ``gymnasium.make("GraspGait-v0", ...)`` (keys that are not config fields, such as
+    ``object`` and ``mu``, are ignored)."""
+    get = ((lambda name: getattr(values, name)) if isinstance(values, GraspGaitConfig)
+           else (lambda name: values.get(name, _UNSET)))
+    out = []
+    for fld in fields(GraspGaitConfig):
         if fld.name in SUPPORTED_FIELDS:
             continue
-        value = getattr(cfg, fld.name)
-        default = fld.default_factory() if fld.default is MISSING else fld.default
-        if value != default:
-            raise GraspGaitInputError(
-                f"{fld.name}={value!r}: the batched GraspGait env (vectorization_mode="
-                f"\"vector_entry_point\") implements only the default {default!r}; leave "
-                f"{fld.name} at its default, or use vectorization_mode=\"sync\"")
+        value = get(fld.name)
+        if value is not _UNSET and value != _default(fld):
+            out.append(fld.name)
+    return out
+
+
+_UNSET = object()
+
+
+def _default(fld: Any) -> Any:
+    return fld.default_factory() if fld.default is MISSING else fld.default
+
+
+def _check_supported(cfg: GraspGaitConfig) -> None:
+    """Refuse config fields the batched step does not implement (set off their default)."""
+    for name in unsupported_fields(cfg)[:1]:
+        value = getattr(cfg, name)
+        default = _default(next(f for f in fields(cfg) if f.name == name))
+        raise GraspGaitInputError(
+            f"{name}={value!r}: the batched GraspGait env (vectorization_mode="
+            f"\"vector_entry_point\") implements only the default {default!r}; leave "
+            f"{name} at its default, or use vectorization_mode=\"sync\"")

@@ -154,7 +154,8 @@ def simulate_plan(plan: Plan, *, video: str | os.PathLike | None = None, seed: i
         raise GraspGaitInputError(f"plan: expected a Plan (Plan.load(path)), got "
                                   f"{type(plan).__name__}")
     if not plan.steps or plan.steps[0].get("op") != "grasp":
-        raise GraspGaitInputError("plan: the first step must be a 'grasp' (docs/formats.md)")
+        raise GraspGaitInputError("plan: the first step must be a 'grasp' (the plan format: "
+                                  "`graspgait plan --help`)")
     rng = np.random.default_rng(seed)
     if isinstance(pose_perturbation, str):
         if pose_perturbation != "random":

@@ -11,8 +11,8 @@ def smoke_run(tmp_path_factory):
     import torch
 
     torch.set_num_threads(1)
-    from agents.config import load_train_config
-    from agents.train import train
+    from graspgait_env.agents.config import load_train_config
+    from graspgait_env.agents.train import train
 
     root = tmp_path_factory.mktemp("runs")
     config = load_train_config("smoke", [f"run_root={root}"])

@@ -24,7 +24,7 @@ def gait_extractor(env, turn_deg: float, **flags):
     """A 36-cell, convolution-free ``GraspMapExtractor`` for ``env`` with the gait inputs
     read from its ``GaitModel`` (``turn_steps``, ``rotations``, ``workspace_widths``) and
     ``flags`` on top. Returns ``(extractor, model, turn_steps, rotations, widths)``."""
-    from agents.policies import GraspMapExtractor
+    from graspgait_env.agents.policies import GraspMapExtractor
 
     m = env.unwrapped.model
     K, R = m.turn_steps(turn_deg), int(m.R)

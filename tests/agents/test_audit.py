@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import gymnasium as gym
 import pytest
+from graspgait_env.agents.audit import AUDIT_KEYS, audit_moves, summarize_audits
+from graspgait_env.agents.evaluate import ReferenceGaits, evaluate, play_episode, run_episodes
+from graspgait_env.baselines.policies import PlannerPolicy
 
-from agents.audit import AUDIT_KEYS, audit_moves, summarize_audits
-from agents.evaluate import ReferenceGaits, evaluate, play_episode, run_episodes
-from baselines.policies import PlannerPolicy
 from graspgait_env.gait import GaitState
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.rule_based import rule_based
@@ -88,9 +88,9 @@ def test_the_shipped_hexagon_agent_is_optimal_from_the_rule_based_gaits_starts(s
     the rule-based method finds a gait under the hand's contact model (fingers 1 and 3),
     the shipped agent needs the optimum's 19 regrasps, no more than that gait's; the
     audit finds no losing move. The agent before it needed 21 from 90/274 deg."""
-    from agents.card import load_agent, shipped_models_dir
-    from agents.envs import make_env
-    from agents.evaluate import agent_predictor
+    from graspgait_env.agents.card import load_agent, shipped_models_dir
+    from graspgait_env.agents.envs import make_env
+    from graspgait_env.agents.evaluate import agent_predictor
 
     model, card = load_agent(shipped_models_dir() / "hexagon.zip")
     env = make_env(card["env_id"], card["env_kwargs"])

@@ -5,8 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-
-from agents.bench import (
+from graspgait_env.agents.bench import (
     SHIPPED_AGENTS,
     agent_rows,
     agents_markdown,
@@ -14,7 +13,8 @@ from agents.bench import (
     plot_bench,
     run_agent_bench,
 )
-from baselines.bench import BenchCase, bench_starts
+from graspgait_env.baselines.bench import BenchCase, bench_starts
+
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel
 
@@ -44,13 +44,13 @@ def test_ratios_pair_the_same_starts():
 
 def test_find_agents(smoke_run):
     assert find_agents("none") == ([], [])
-    agents, notes = find_agents("shipped")
-    assert sorted([a.name for a in agents] + [n.split()[1].rstrip(":") for n in notes]) == \
-        sorted(SHIPPED_AGENTS)
+    agents, notes = find_agents("shipped")  # every shipped agent, none missing
+    assert sorted(a.name for a in agents) == sorted(SHIPPED_AGENTS) and not notes
     (agent,), notes = find_agents(str(smoke_run.model_path))
     assert agent.name == "model" and not notes
     assert agent.runs_on("ellipse") and not agent.runs_on("pentagon")
-    with pytest.raises(GraspGaitInputError, match=r"--agents 'nope': no such model"):
+    with pytest.raises(GraspGaitInputError, match=r"--agents: MODEL 'nope': no such file "
+                       r"and no shipped agent.*circle, ellipse"):
         find_agents("nope")
 
 
@@ -85,7 +85,6 @@ def test_an_agent_with_its_own_contact_model_is_compared_under_it():
     assert "| hand |" in agents_markdown(own + point_refs)
 
 
-@pytest.mark.skipif(not (find_agents("shipped")[0]), reason="no shipped model")
 def test_hand_agent_runs_from_starts_legal_under_its_contact_model():
     """At mu 0.8 some point-contact bench starts are not force-closure for the hand; the
     shipped ellipse agent (hand contacts) runs from its own model's starts, with the
@@ -100,7 +99,7 @@ def test_hand_agent_runs_from_starts_legal_under_its_contact_model():
 
 
 def test_a_generalists_random_env_keywords_are_dropped_for_one_object():
-    from agents.envs import env_kwargs_for
+    from graspgait_env.agents.envs import env_kwargs_for
 
     kw = env_kwargs_for("GraspGait-v0", "GraspGaitRandom-v0",
                         {"level": 1, "episodes_per_object": 8, "beta": 0.03}, "ellipse", 0.7)
@@ -109,7 +108,7 @@ def test_a_generalists_random_env_keywords_are_dropped_for_one_object():
 
 
 def test_plot_labels_an_agent_with_the_hands_contacts(tmp_path):
-    from agents.bench import _contacts_note
+    from graspgait_env.agents.bench import _contacts_note
 
     hand = BenchCase("ellipse", 0.7, "a", "agent:h", True, 0, 20, 11, 360.0, 0.01, "",
                      contact_model="hand", optimal_regrasps=10, rule_regrasps=11)
@@ -120,7 +119,7 @@ def test_plot_labels_an_agent_with_the_hands_contacts(tmp_path):
 
 
 def test_tables_1_and_6_1_leave_the_agents_to_their_own_table():
-    from baselines.bench import markdown_report
+    from graspgait_env.baselines.bench import markdown_report
 
     cases = [_case("optimal", "a", True, 8), _case("rule", "a", True, 9),
              _case("agent:x", "a", True, 12)]

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import pytest
-
-from agents.config import (
+from graspgait_env.agents.config import (
     TrainConfig,
     apply_overrides,
     bundled_train_configs,
@@ -12,6 +11,7 @@ from agents.config import (
     load_train_config,
     parse_override,
 )
+
 from graspgait_env.errors import GraspGaitInputError
 
 
@@ -98,11 +98,10 @@ def test_each_shipped_model_card_holds_its_bundled_config(name):
     a card was written takes its default)."""
     import json
 
-    from agents.bench import shipped_models_dir
+    from graspgait_env.agents.bench import shipped_models_dir
 
     card = shipped_models_dir() / f"{name}.json"
-    if not card.is_file():
-        pytest.skip(f"{card} is not there")
+    assert card.is_file(), f"the shipped card {card} is missing from this install"
     shipped = json.loads(card.read_text(encoding="utf-8"))
     # run_root is where the run was written, not how it was trained
     assert load_train_config(name, [f"run_root={shipped['config']['run_root']}"]) \
@@ -114,11 +113,11 @@ def test_the_shipped_hexagon_is_one_stage_with_the_regrasp_scorer():
     """The hexagon is trained in one run (no ``init``) with the shared regrasp scorer."""
     import json
 
-    from agents.card import load_agent, shipped_models_dir
-    from agents.policies import MaskableRegraspScorerPolicy
+    from graspgait_env.agents.card import load_agent, shipped_models_dir
+    from graspgait_env.agents.policies import MaskableRegraspScorerPolicy
 
     card = json.loads((shipped_models_dir() / "hexagon.json").read_text(encoding="utf-8"))
     assert card["config"]["init_model"] is None and "init" not in card
-    assert card["config"]["policy"] == "agents.policies:MaskableRegraspScorerPolicy"
+    assert card["config"]["policy"] == "graspgait_env.agents.policies:MaskableRegraspScorerPolicy"
     model, _ = load_agent(shipped_models_dir() / "hexagon.zip")
     assert isinstance(model.policy, MaskableRegraspScorerPolicy)

@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import gymnasium as gym
 import pytest
-
-from agents.envs import env_kwargs_for
-from agents.evaluate import (
+from graspgait_env.agents.envs import env_kwargs_for
+from graspgait_env.agents.evaluate import (
     ReferenceGaits,
     evaluate,
     run_episodes,
     summarize_episodes,
     write_evaluation,
 )
-from baselines.policies import PlannerPolicy
+from graspgait_env.baselines.policies import PlannerPolicy
+
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.rule_based import rule_based
@@ -88,11 +88,10 @@ def test_optimum_comparison_is_exact_for_the_planners_themselves(ellipse_env):
 
 
 def test_a_shipped_agent_never_beats_the_optimum():
-    from agents.bench import shipped_models_dir
+    from graspgait_env.agents.bench import shipped_models_dir
 
     path = shipped_models_dir() / "ellipse.zip"
-    if not path.is_file():
-        pytest.skip(f"{path} is not there yet")
+    assert path.is_file(), f"the shipped model {path} is missing from this install"
     res = evaluate(path, episodes=5, seed=1)
     wins = [ep for ep in res["episodes"] if ep["success"]]
     assert wins  # a trained agent succeeds, so the comparison below is made

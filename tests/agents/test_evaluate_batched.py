@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import pytest
-
-from agents.card import load_agent
-from agents.envs import make_env
-from agents.evaluate import (
+from graspgait_env.agents.card import load_agent
+from graspgait_env.agents.envs import make_env
+from graspgait_env.agents.evaluate import (
     ReferenceGaits,
     agent_batch_predictor,
     agent_predictor,
@@ -25,11 +24,10 @@ def _strip(records):
 def test_batched_records_equal_the_serial_ones_for_a_shipped_agent(name):
     """Starts, success, regrasps, moves and references: episode for episode, across waves
     (7 episodes in waves of 3) and for the hexagon's look-ahead observation."""
-    from agents.bench import shipped_models_dir
+    from graspgait_env.agents.bench import shipped_models_dir
 
     path = shipped_models_dir() / f"{name}.zip"
-    if not path.is_file():
-        pytest.skip(f"{path} is not there yet")
+    assert path.is_file(), f"the shipped model {path} is missing from this install"
     model, card = load_agent(path)
     kwargs = card["env_kwargs"]
     refs = ReferenceGaits()
@@ -62,8 +60,11 @@ def test_batched_env_only_where_it_reproduces_the_env():
     assert batched_eval_env("GraspGaitMujoco-v1", {"object": "circle"}) is None
     assert batched_eval_env("GraspGaitRandom-v0", {}) is None
     assert batched_eval_env("GraspGait-v0", {"object": "circle"},
-                            ("agents.wrappers:LegalActionWrapper",)) is None
-    venv = batched_eval_env("GraspGait-v0", {"object": "circle"}, (), 5)
+                            ("graspgait_env.agents.wrappers:LegalActionWrapper",)) is None
+    # a field the batched step does not implement: played one by one, never refused
+    assert batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 2}) is None
+    # ... but at its default it changes nothing, and the batched env applies
+    venv = batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 0}, (), 5)
     assert venv.num_envs == 5
 
 

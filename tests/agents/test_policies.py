@@ -6,15 +6,15 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from graspgait_env.agents.card import load_agent, save_agent
+from graspgait_env.agents.config import load_train_config
+from graspgait_env.agents.policies import GraspMapExtractor, layout_of
+from graspgait_env.agents.train import build_model, make_vec_env_for
 
-from agents.card import load_agent, save_agent
-from agents.config import load_train_config
-from agents.policies import GraspMapExtractor, layout_of
-from agents.train import build_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
-_EXTRACTOR = "agents.policies:GraspMapExtractor"
+_EXTRACTOR = "graspgait_env.agents.policies:GraspMapExtractor"
 
 
 def _env(**kw):

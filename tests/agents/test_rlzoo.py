@@ -6,10 +6,9 @@ from importlib.resources import files
 
 import torch
 import yaml
-
-from agents.card import load_agent, read_card
-from agents.envs import import_object
-from agents.rlzoo import TorchThreadsCallback
+from graspgait_env.agents.card import load_agent, read_card
+from graspgait_env.agents.envs import import_object
+from graspgait_env.agents.rlzoo import TorchThreadsCallback
 
 
 def test_bundled_ppo_yml_names_importable_wrappers_and_callback():
@@ -32,8 +31,8 @@ def test_threads_callback_sets_torch_threads():
 
 RLZOO_CONFIG = """!!python/object/apply:collections.OrderedDict
 - - - env_wrapper
-    - - agents.wrappers.SolvableStartWrapper
-      - agents.wrappers.LegalActionWrapper
+    - - graspgait_env.agents.wrappers.SolvableStartWrapper
+      - graspgait_env.agents.wrappers.LegalActionWrapper
   - - policy
     - MlpPolicy
 """
@@ -57,8 +56,8 @@ def test_a_zip_saved_by_rl_zoo_gets_a_card(smoke_run, tmp_path):
     assert read_card(zip_path) == {}
     model, card = load_agent(zip_path)
     assert card["env_id"] == "GraspGait-v0" and card["env_kwargs"] == {}
-    assert card["wrappers"] == ["agents.wrappers.SolvableStartWrapper",
-                                "agents.wrappers.LegalActionWrapper"]
+    assert card["wrappers"] == ["graspgait_env.agents.wrappers.SolvableStartWrapper",
+                                "graspgait_env.agents.wrappers.LegalActionWrapper"]
     assert card["algo"] == "maskable_ppo"  # the zip's policy class, whatever args.yml says
     assert type(model).__name__ == "MaskablePPO"
     plain = tmp_path / "plain.zip"

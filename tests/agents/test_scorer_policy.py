@@ -6,17 +6,21 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from graspgait_env.agents.card import load_agent, save_agent
+from graspgait_env.agents.config import TrainConfig, load_train_config
+from graspgait_env.agents.policies import (
+    REGRASP_CHANNELS,
+    GraspMapExtractor,
+    MaskableRegraspScorerPolicy,
+)
+from graspgait_env.agents.train import build_model, init_from_model, make_vec_env_for
 
-from agents.card import load_agent, save_agent
-from agents.config import TrainConfig, load_train_config
-from agents.policies import REGRASP_CHANNELS, GraspMapExtractor, MaskableRegraspScorerPolicy
-from agents.train import build_model, init_from_model, make_vec_env_for
 from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
 _SCORER = [
-    "policy=agents.policies:MaskableRegraspScorerPolicy",
-    "features_extractor=agents.policies:GraspMapExtractor",
+    "policy=graspgait_env.agents.policies:MaskableRegraspScorerPolicy",
+    "features_extractor=graspgait_env.agents.policies:GraspMapExtractor",
     "features_extractor_kwargs={cells: 36, conv: false, turn_steps: 180, rotations: 45, "
     "workspace_widths: [46, 46, 46]}",
 ]
@@ -153,11 +157,13 @@ def test_init_logit_scale_scales_every_logit_scores_included(tmp_path):
 
 def test_scorer_policy_needs_maskable_ppo_and_the_extractor(tmp_path):
     with pytest.raises(GraspGaitInputError, match="needs algo: maskable_ppo"):
-        TrainConfig(name="x", algo="ppo", policy="agents.policies:MaskableRegraspScorerPolicy")
+        TrainConfig(name="x", algo="ppo",
+                    policy="graspgait_env.agents.policies:MaskableRegraspScorerPolicy")
     with pytest.raises(GraspGaitInputError, match="policy='MlpPolicy2'"):
         TrainConfig(name="x", policy="MlpPolicy2")
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", _SCORER[0]])
-    with pytest.raises(GraspGaitInputError, match="needs agents.policies:GraspMapExtractor"):
+    with pytest.raises(GraspGaitInputError,
+                       match="needs graspgait_env.agents.policies:GraspMapExtractor"):
         build_model(cfg, make_vec_env_for(cfg))
 
 

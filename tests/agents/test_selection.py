@@ -1,16 +1,17 @@
-"""Which periodic evaluation becomes ``best.zip``: :func:`agents.train.selection_score`."""
+"""Which periodic evaluation becomes ``best.zip``:
+:func:`graspgait_env.agents.train.selection_score`."""
 
 from __future__ import annotations
 
 import doctest
 import json
 
+import graspgait_env.agents.train
 import pytest
+from graspgait_env.agents.card import read_card
+from graspgait_env.agents.config import load_train_config
+from graspgait_env.agents.train import selection_score, train
 
-import agents.train
-from agents.card import read_card
-from agents.config import load_train_config
-from agents.train import selection_score, train
 from graspgait_env.errors import GraspGaitInputError
 
 
@@ -39,7 +40,7 @@ def test_with_a_floor_the_fewest_regrasps_win_among_those_reaching_it():
 
 
 def test_selection_score_doctest():
-    assert doctest.testmod(agents.train).failed == 0
+    assert doctest.testmod(graspgait_env.agents.train).failed == 0
 
 
 @pytest.mark.parametrize("bad", [-0.1, 1.5, "high", True])

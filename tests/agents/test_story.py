@@ -1,4 +1,5 @@
-"""``graspgait story`` / agents.story: rule-based, optimal and learned gaits from one start."""
+"""``graspgait story`` / graspgait_env.agents.story: rule-based, optimal and learned gaits from one
+start."""
 
 from __future__ import annotations
 
@@ -6,8 +7,8 @@ import json
 from pathlib import Path
 
 import pytest
+from graspgait_env.agents.story import GAITS, learned_gait, story_table, tell_story
 
-from agents.story import GAITS, learned_gait, story_table, tell_story
 from graspgait_env.cli import main
 from graspgait_env.plan import Plan, validate_plan
 from graspgait_env.planners.exact import optimal_gait

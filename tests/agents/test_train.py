@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from graspgait_env.agents.card import load_agent, read_card, save_agent
+from graspgait_env.agents.config import load_train_config
+from graspgait_env.agents.train import build_model, init_from_model, make_vec_env_for, train
 
-from agents.card import load_agent, read_card, save_agent
-from agents.config import load_train_config
-from agents.train import build_model, init_from_model, make_vec_env_for, train
 from graspgait_env.errors import GraspGaitInputError
 
 
@@ -114,10 +113,11 @@ def test_resume_continues_the_run_from_a_checkpoint(tmp_path, smoke_run):
 def test_plain_ppo_with_the_legal_action_wrapper_trains(tmp_path):
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", "algo=ppo", "eval_freq=0",
                                       "checkpoint_freq=0",
-                                      "wrappers=[agents.wrappers.LegalActionWrapper]"])
+                                      "wrappers=[graspgait_env.agents.wrappers.LegalActionWrapper]"])
     res = train(cfg, progress=False)
     card = read_card(res.model_path)
-    assert card["algo"] == "ppo" and card["wrappers"] == ["agents.wrappers.LegalActionWrapper"]
+    assert card["algo"] == "ppo"
+    assert card["wrappers"] == ["graspgait_env.agents.wrappers.LegalActionWrapper"]
     assert res.last_eval["illegal_action_rate"] is not None
     model, _ = load_agent(res.model_path)
     assert type(model).__name__ == "PPO"
@@ -154,10 +154,12 @@ def test_init_model_starts_from_the_saved_weights_and_states_their_training(tmp_
 
 
 def test_init_model_takes_a_shipped_models_name():
-    from agents.card import resolve_model, shipped_models_dir
+    from graspgait_env.agents.card import resolve_model, shipped_models_dir
 
     assert resolve_model("ellipse") == shipped_models_dir() / "ellipse.zip"
-    assert resolve_model("nope") == Path("nope")  # not shipped: the path, refused later
+    with pytest.raises(GraspGaitInputError, match=r"MODEL 'nope': no such file and no "
+                       r"shipped agent of that name.*ellipse"):
+        resolve_model("nope")
     cfg = load_train_config("ellipse", ["init_model=ellipse"])
     model = build_model(cfg, make_vec_env_for(cfg, n_envs=1))
     init = init_from_model(model, cfg)
@@ -170,10 +172,10 @@ def test_init_model_takes_a_shipped_models_name():
 def test_init_model_refuses_a_model_that_does_not_fit(tmp_path, smoke_run):
     src = str(smoke_run.model_path)
     for overrides, message in (
-            (["init_model=nope.zip"], r"init_model='nope.zip': no such model"),
+            (["init_model=nope.zip"], r"init_model: MODEL 'nope.zip': no such file"),
             (["net_arch=[8]"], r"its network does not fit .*set net_arch=\[16\]"),
             (["env_kwargs.map_lines=true"], r"its observation_space is .*env_kwargs="),
-            (["algo=ppo", "wrappers=[agents.wrappers.LegalActionWrapper]"],
+            (["algo=ppo", "wrappers=[graspgait_env.agents.wrappers.LegalActionWrapper]"],
              r"a maskable_ppo model, the config trains ppo")):
         cfg = load_train_config("smoke", [f"run_root={tmp_path / 'r'}", f"init_model={src}",
                                           *overrides])
@@ -183,11 +185,11 @@ def test_init_model_refuses_a_model_that_does_not_fit(tmp_path, smoke_run):
 
 
 def test_train_wrappers_wrap_the_training_envs_only(tmp_path):
-    from agents.wrappers import SolvableStartWrapper
+    from graspgait_env.agents.wrappers import SolvableStartWrapper
 
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", "eval_freq=0",
                                       "checkpoint_freq=0",
-                                      "train_wrappers=[agents.wrappers.SolvableStartWrapper]"])
+                                      "train_wrappers=[graspgait_env.agents.wrappers.SolvableStartWrapper]"])
     venv = make_vec_env_for(cfg)
     for env in venv.envs:
         while not isinstance(env, SolvableStartWrapper):
@@ -197,12 +199,14 @@ def test_train_wrappers_wrap_the_training_envs_only(tmp_path):
     res = train(cfg, progress=False)
     card = read_card(res.model_path)
     assert card["wrappers"] == []  # what evaluate runs the model in
-    assert card["config"]["train_wrappers"] == ["agents.wrappers.SolvableStartWrapper"]
+    assert card["config"]["train_wrappers"] == [
+        "graspgait_env.agents.wrappers.SolvableStartWrapper"]
     with pytest.raises(GraspGaitInputError, match=r"train_wrappers='x': must be a list"):
         load_train_config("smoke", ["train_wrappers=x"])
     with pytest.raises(GraspGaitInputError, match=r"vec_env='batched'.*train_wrappers"):
         make_vec_env_for(load_train_config("smoke", [
-            "vec_env=batched", "train_wrappers=[agents.wrappers.RuleBasedStartWrapper]"]))
+            "vec_env=batched",
+            "train_wrappers=[graspgait_env.agents.wrappers.RuleBasedStartWrapper]"]))
 
 
 def test_init_logit_scale_flattens_the_policy_and_keeps_its_greedy_actions(tmp_path, smoke_run):

@@ -1,7 +1,7 @@
 """Ray as the engine: the bench, the campaign and training give the serial numbers.
 
 One local Ray (``num_cpus=2``) is shared by the module's tests (starting one takes
-seconds); the library's :func:`baselines.scale_out.ray_session` finds it running and
+seconds); the library's :func:`graspgait_env.baselines.scale_out.ray_session` finds it running and
 leaves it so.
 """
 
@@ -11,16 +11,16 @@ import dataclasses
 import logging
 
 import pytest
+from graspgait_env.baselines.bench import markdown_report, run_bench
+from graspgait_env.baselines.scale_out import bench_on_ray, campaign, parse_seeds, run_tasks
 
-from baselines.bench import markdown_report, run_bench
-from baselines.scale_out import bench_on_ray, campaign, parse_seeds, run_tasks
 from graspgait_env.cli import main
 from graspgait_env.errors import GraspGaitInputError
 
 
 @pytest.fixture(scope="module")
 def local_ray():
-    ray = pytest.importorskip("ray")
+    import ray  # the [ray] extra: `make test` installs every extra, so a missing one fails
     ray.init(num_cpus=2, include_dashboard=False, logging_level=logging.ERROR,
              log_to_driver=False, object_store_memory=100 * 1024**2)
     yield ray
@@ -95,8 +95,8 @@ def test_campaign_on_ray_gives_the_serial_runs(local_ray):
 
 @pytest.mark.slow
 def test_train_seeds_as_ray_tune_trials_give_the_serial_numbers(local_ray, tmp_path):
-    from agents.config import load_train_config
-    from agents.ray_train import train_seeds
+    from graspgait_env.agents.config import load_train_config
+    from graspgait_env.agents.ray_train import train_seeds
 
     config = load_train_config("smoke", [f"run_root={tmp_path}"])
     serial = train_seeds(config, [0, 1], progress=False)
@@ -110,8 +110,8 @@ def test_train_seeds_as_ray_tune_trials_give_the_serial_numbers(local_ray, tmp_p
 @pytest.mark.slow
 def test_a_failed_tune_trial_is_reported_and_the_others_kept(local_ray, tmp_path):
     """Seed 2**64 overflows torch's seed: that trial fails, seed 0's still trains."""
-    from agents.config import load_train_config
-    from agents.ray_train import train_seeds
+    from graspgait_env.agents.config import load_train_config
+    from graspgait_env.agents.ray_train import train_seeds
 
     config = load_train_config("smoke", [f"run_root={tmp_path}"])
     trials = train_seeds(config, [0, 2**64], use_ray=True, progress=False)
@@ -122,8 +122,8 @@ def test_a_failed_tune_trial_is_reported_and_the_others_kept(local_ray, tmp_path
 
 def test_bench_agents_on_ray_gives_the_serial_rows(local_ray):
     """One Ray task per agent, object and mu; the rows are the serial bench's."""
-    from agents.bench import find_agents, run_agent_bench
-    from agents.ray_train import bench_agents_on_ray
+    from graspgait_env.agents.bench import find_agents, run_agent_bench
+    from graspgait_env.agents.ray_train import bench_agents_on_ray
 
     agents, _ = find_agents("circle,pentagon")
     args = (agents, ["pentagon", "circle"], [0.7], 2)
@@ -150,10 +150,10 @@ def test_cli_bench_ray_with_an_agent_writes_the_serial_json(local_ray, tmp_path,
 
 @pytest.mark.slow
 def test_evaluate_on_ray_gives_the_serial_result(local_ray, tmp_path):
-    from agents.config import load_train_config
-    from agents.evaluate import evaluate
-    from agents.ray_train import evaluate_on_ray
-    from agents.train import train
+    from graspgait_env.agents.config import load_train_config
+    from graspgait_env.agents.evaluate import evaluate
+    from graspgait_env.agents.ray_train import evaluate_on_ray
+    from graspgait_env.agents.train import train
 
     model = train(load_train_config("smoke", [f"run_root={tmp_path}"]), progress=False)
     serial = evaluate(model.model_path, episodes=5, seed=3)

@@ -156,8 +156,8 @@ def test_perf_bad_repeat(capsys):
     assert "--repeat" in _one_line_error(capsys.readouterr().err)
 
 
-@pytest.mark.skipif(not SCRIPT.exists(), reason="console script not installed in this env")
 def test_console_script(tmp_path):
+    assert SCRIPT.exists(), f"the console script {SCRIPT} is not installed"
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: bad\ntype: circle\nradius: -2\n")
     r = subprocess.run([str(SCRIPT), "map", str(bad), "--mu", "0.7"],

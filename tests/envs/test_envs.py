@@ -99,9 +99,8 @@ def test_make_in_fresh_interpreter_with_package_prefix():
     r = _fresh("import gymnasium as gym, graspgait_env\n"
                "print('GraspGait-v0' in gym.registry)")
     assert r.returncode == 0, r.stderr
-    if r.stdout.strip() != "True":
-        pytest.skip("graspgait_env/__init__.py does not yet call "
-                    "graspgait_env.envs.registration.register_envs()")
+    assert r.stdout.strip() == "True", ("`import graspgait_env` must register the ids "
+                                        "(graspgait_env.envs.registration.register_envs())")
     r = _fresh("import gymnasium as gym\n"
                "env = gym.make('graspgait_env:GraspGait-v0')\n"
                "env.reset(seed=0)\n"
@@ -237,7 +236,8 @@ def test_start_option_errors(ellipse_env):
 
 
 def test_success_ends_the_episode_with_the_bonus():
-    from baselines.policies import plan_actions, plan_states
+    from graspgait_env.baselines.policies import plan_actions, plan_states
+
     from graspgait_env.planners.exact import optimal_gait
 
     env = make("GraspGait-v0", object="pentagon")

@@ -63,7 +63,7 @@ _REGRASPS_BEFORE = {"circle": 7.8, "ellipse": 13.9, "pentagon": 12.1, "hexagon":
 
 
 def _bench_runs(name: str) -> list:
-    from baselines.bench import _model, bench_starts
+    from graspgait_env.baselines.bench import _model, bench_starts
 
     m = _model(name, 0.7)
     return [modified_search(m, s, 360.0) for s in bench_starts(m, 10)]

@@ -5,8 +5,7 @@ from __future__ import annotations
 import statistics
 
 import pytest
-
-from baselines.bench import (
+from graspgait_env.baselines.bench import (
     THESIS_OBJECTS,
     THESIS_TABLE_6_1,
     bench_starts,
@@ -15,6 +14,7 @@ from baselines.bench import (
     run_case,
     summarize,
 )
+
 from graspgait_env.gait import GaitModel
 
 
@@ -86,7 +86,8 @@ def test_table_6_1_count_readings_as_measured():
     and the cycle in progress completed, i.e. on until the start's fingers hold again
     (8.7 / 13.6 / 12.9 / 18.6). On the circle no start needs more than 8 regrasps (mean
     7.96 over every legal start)."""
-    from baselines.bench import _model
+    from graspgait_env.baselines.bench import _model
+
     from graspgait_env.planners.registry import get_planner
 
     rule = get_planner("rule")

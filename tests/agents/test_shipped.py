@@ -1,0 +1,163 @@
+"""The shipped agents: there, by name, on any object file and friction, and a model saved
+by graspgait_env 0.1 (before ``agents`` moved beneath ``graspgait_env``) still loads."""
+
+from __future__ import annotations
+
+import json
+import sys
+import types
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from graspgait_env.agents.bench import SHIPPED_AGENTS
+from graspgait_env.agents.card import (
+    describe_shipped,
+    load_agent,
+    resolve_model,
+    shipped_agents,
+    shipped_models_dir,
+)
+from graspgait_env.agents.config import TrainConfig
+from graspgait_env.agents.envs import make_env
+from graspgait_env.agents.evaluate import evaluate
+from graspgait_env.agents.legacy import legacy_module_names, upgrade_card, upgrade_import_path
+
+from graspgait_env.errors import GraspGaitInputError
+
+ROOT = Path(__file__).resolve().parents[2]
+LEGACY = Path(__file__).parent / "data" / "legacy_0_1"
+
+# An object no training run saw: a kite (no bundled object, outside the procedural
+# generator's regular families), evaluated at a friction no shipped card trains at.
+KITE = ("name: kite\ntype: polygon\n"
+        "vertices: [[0.07, 0.0], [0.0, 0.05], [-0.09, 0.0], [0.0, -0.05]]\n")
+
+
+def test_every_shipped_agent_is_installed_with_both_cards():
+    """A missing model or card fails here (it is not skipped anywhere)."""
+    assert shipped_agents() == sorted(SHIPPED_AGENTS)
+    repo = sorted(p.stem for p in (ROOT / "agents" / "models").glob("*.zip"))
+    assert repo == sorted(SHIPPED_AGENTS)
+    for name in SHIPPED_AGENTS:
+        for suffix in (".zip", ".json", ".md"):
+            assert (shipped_models_dir() / f"{name}{suffix}").is_file(), name + suffix
+    described = dict(describe_shipped())
+    assert sorted(described) == sorted(SHIPPED_AGENTS)
+    assert "GraspGaitRandom-v0" in described["random"] and "x the optimum" in described["random"]
+
+
+def test_shipped_names_resolve_and_unknown_names_list_what_exists(tmp_path, monkeypatch):
+    assert resolve_model("ellipse") == shipped_models_dir() / "ellipse.zip"
+    assert resolve_model("ellipse.zip") == shipped_models_dir() / "ellipse.zip"
+    # a file of that name in the working folder is the user's, and wins
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "ellipse.zip").write_bytes(b"")
+    assert resolve_model("ellipse") == Path("ellipse.zip")
+    with pytest.raises(GraspGaitInputError) as err:
+        resolve_model("elipse")
+    msg = str(err.value)
+    assert "did you mean 'ellipse'?" in msg and "evaluate --list" in msg
+    assert ", ".join(sorted(SHIPPED_AGENTS)) in msg
+    assert "agents/models" not in msg  # no path that only a clone has
+
+
+def test_load_agent_takes_a_name_and_its_zip_loads_without_the_loader():
+    """The shipped zips name graspgait_env.agents.policies: plain SB3 loads them."""
+    from sb3_contrib import MaskablePPO
+
+    model, card = load_agent("hexagon")
+    assert card["config"]["policy"].startswith("graspgait_env.agents.policies:")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "could not deserialize" warning either
+        plain = MaskablePPO.load(shipped_models_dir() / "hexagon.zip", device="cpu")
+    assert type(plain.policy).__module__ == "graspgait_env.agents.policies"
+    assert "agents" not in sys.modules
+
+
+@pytest.mark.parametrize("name", SHIPPED_AGENTS)
+def test_every_shipped_model_evaluates_on_an_unseen_object_file(name, tmp_path):
+    """Any object file, any friction: the look-ahead of ``random`` included (its episodes
+    are played one by one, since the batched env does not implement that field)."""
+    path = tmp_path / "kite.yaml"
+    path.write_text(KITE)
+    res = evaluate(name, object=str(path), mu=0.6, episodes=2, seed=3)
+    assert res["object"] == "kite" and res["mu"] == 0.6
+    assert res["env_id"] == "GraspGait-v0"
+    assert len(res["episodes"]) == 2
+    for ep in res["episodes"]:
+        assert ep["object"] == "kite" and ep["steps"] >= 1
+        if ep["success"]:
+            assert ep["solvable"] and ep["regrasps"] >= ep["optimal_regrasps"]
+    if name == "random":
+        assert res["env_kwargs"]["regrasp_lookahead"] == 3
+
+
+def test_a_model_saved_by_0_1_loads_and_acts_as_the_shipped_one():
+    """The ellipse agent and its card as graspgait_env 0.1 wrote them (its pickles and
+    card name ``agents.policies``): it loads, its card's import paths are today's, and
+    it plays the actions of the shipped (re-saved) ellipse agent."""
+    legacy_card = json.loads((LEGACY / "ellipse.json").read_text())
+    assert legacy_card["config"]["features_extractor"] == "agents.policies:GraspMapExtractor"
+    old, card = load_agent(LEGACY / "ellipse.zip")
+    assert card["config"]["features_extractor"] == \
+        "graspgait_env.agents.policies:GraspMapExtractor"
+    TrainConfig(**card["config"])  # the card's config is a valid config again
+    new, _ = load_agent("ellipse")
+    assert type(old.policy.features_extractor) is type(new.policy.features_extractor)
+    env = make_env("GraspGait-v0", card["env_kwargs"])
+    for seed in range(3):
+        obs, _ = env.reset(seed=seed)
+        mask = env.unwrapped.action_masks()
+        a_old = old.predict(obs, action_masks=mask, deterministic=True)[0]
+        a_new = new.predict(obs, action_masks=mask, deterministic=True)[0]
+        assert a_old == a_new
+    assert "agents" not in sys.modules and "agents.policies" not in sys.modules
+
+
+def test_legacy_names_leave_a_users_own_agents_package_alone():
+    mine = types.ModuleType("agents")
+    sys.modules["agents"] = mine
+    try:
+        with legacy_module_names():
+            import agents.policies  # noqa: F401 - the 0.1 name, while unpickling
+
+            assert sys.modules["agents.policies"] is sys.modules["graspgait_env.agents.policies"]
+            assert sys.modules["agents"] is sys.modules["graspgait_env.agents"]
+        assert sys.modules["agents"] is mine and "agents.policies" not in sys.modules
+        # the real package keeps its own spec (importlib.resources reads through it)
+        assert shipped_models_dir().is_dir()
+    finally:
+        del sys.modules["agents"]
+
+
+def test_import_paths_of_0_1_are_upgraded():
+    assert upgrade_import_path("agents.policies:X") == "graspgait_env.agents.policies:X"
+    assert upgrade_import_path("baselines.policies.P") == "graspgait_env.baselines.policies.P"
+    assert upgrade_import_path("agentsmith.x:Y") == "agentsmith.x:Y"
+    assert upgrade_import_path("my.agents.policies:X") == "my.agents.policies:X"
+    card = {"wrappers": ["agents.wrappers:LegalActionWrapper"], "name": "agents x",
+            "config": {"policy": "MlpPolicy"}}
+    assert upgrade_card(card) == {"wrappers": ["graspgait_env.agents.wrappers:"
+                                               "LegalActionWrapper"],
+                                  "name": "agents x", "config": {"policy": "MlpPolicy"}}
+    with pytest.warns(DeprecationWarning, match="graspgait_env.agents.policies"):
+        cfg = TrainConfig(algo="maskable_ppo",
+                          policy="agents.policies:MaskableRegraspScorerPolicy")
+    assert cfg.policy == "graspgait_env.agents.policies:MaskableRegraspScorerPolicy"
+
+
+def test_evaluate_random_on_an_object_file_plays_single_envs(tmp_path, monkeypatch):
+    """The batched path refuses the look-ahead, so evaluation falls back by itself; the
+    records equal those of the single-env loop (they are that loop)."""
+    import graspgait_env.agents.evaluate as ev
+
+    calls = []
+    real = ev.run_episodes
+    monkeypatch.setattr(ev, "run_episodes", lambda *a, **k: calls.append(1) or real(*a, **k))
+    path = tmp_path / "kite.yaml"
+    path.write_text(KITE)
+    res = evaluate("random", object=str(path), episodes=2)
+    assert calls == [1] and len(res["episodes"]) == 2
+    assert np.isfinite(res["wall_s"])
