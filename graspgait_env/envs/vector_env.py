@@ -54,7 +54,7 @@ SUPPORTED_FIELDS: frozenset[str] = frozenset({
     "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
     "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
     "map_window_deg", "map_window_cells", "map_lines", "contact_model", "rotation_lookahead",
-    "forbid_reversal", "forbid_revisit",
+    "regrasp_lookahead", "forbid_reversal", "forbid_revisit",
 })
 
 
@@ -147,9 +147,13 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     each row, ``rotation_lookahead`` the rotation look-ahead, ``contact_model`` changes
     the shared gait model, ``to_go_weight`` looks up the optimum's regrasps to go of
     each sub-env that regrasps, one at a time (this opt-in reward slows the batched
-    step), ``forbid_reversal`` and ``forbid_revisit`` remove the same moves from the
-    masks as the single env (``forbid_revisit`` keeps each sub-env's visited states in
-    a Python set and checks them row by row, so it slows the batched step too). A
+    step), ``regrasp_lookahead`` writes the reach look-ahead of every row in one call
+    of :meth:`RegraspReach.move_shortfalls_batch
+    <graspgait_env.planners.reach.RegraspReach.move_shortfalls_batch>`, the one
+    implementation that the single env calls for its one row, ``forbid_reversal`` and
+    ``forbid_revisit`` remove the same moves from the masks as the single env
+    (``forbid_revisit`` keeps each sub-env's visited states in a Python set and checks
+    them row by row, so it slows the batched step too). A
     field added to the config later (:data:`SUPPORTED_FIELDS` does not list it) is
     accepted at its default and raises ``ValueError`` naming it otherwise.
     ``render_mode`` must be None: the batched env draws nothing (make a single env with
@@ -157,7 +161,8 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
 
     ## Version History
 
-    - v0: initial version.
+    - v0: initial version; ``regrasp_lookahead`` batched since graspgait_env 0.2 (before,
+      refused away from its default).
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": [],
@@ -276,6 +281,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # rotation_lookahead: the single env's table of the regrasps each rotation opens
         self._openings = env._openings
         self._rot_delta = env._rot_delta
+        # regrasp_lookahead: the single env's reach tables, read for the whole batch by
+        # the one implementation both envs call (RegraspReach.move_shortfalls_batch)
+        self._reach = env._reach
 
         # batched state: object angle k, contacts c (-1: free), workspace positions p
         # (-1: free), held fingers f < g and free finger h, mask, counters
@@ -644,6 +652,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
                      | self._openings[h, c[self._arN, self._g][:, None], i])
             np.logical_and(opens, mask[:, :2 * R], out=opens)
             o[:, self.layout.lookahead] = opens
+        if self._reach is not None:  # the reach look-ahead, every row
+            arN, f, g = self._arN, self._f, self._g
+            o[:, self.layout.reach] = self._reach.move_shortfalls_batch(
+                self._h, f, g, p[arN, f], p[arN, g], k, mask, self._rot_delta)
         # episode ends and reward (GraspGaitEnv._reward's table, term by term, same order)
         is_success = self._k_success[ki]
         terminated = live & (self._k_ends[ki] | ~mask.any(axis=1))

@@ -166,42 +166,100 @@ class RegraspReach:
         restrictions); ``rot_delta`` the signed grid steps of the ``2 R`` rotations. Entry
         values are shortfalls over ``abs(K)`` grid steps (0: the turn is reached), ``(abs(K)
         + B + 1) / abs(K)`` for an illegal action or one that opens nothing.
+
+        The row of :meth:`move_shortfalls_batch` for this one state (one implementation
+        for the single and the batched envs).
+        """
+        def row(x: int) -> NDArray[np.int64]:
+            return np.array([x], dtype=np.int64)
+
+        return self.move_shortfalls_batch(row(h), row(f), row(g), row(p_f), row(p_g), row(k),
+                                          mask[None, :], rot_delta)[0]
+
+    def _stacked_levels(self) -> NDArray[np.int64]:
+        """``levels[j][pair]`` padded into one ``(D, 3, L, L)`` array (``L`` the longest
+        finger's index range; padding ``unreachable``), built once: the batch gathers
+        every row's table in one call."""
+        if getattr(self, "_stack", None) is None:
+            L = int(max(self._seg.L))
+            st = np.full((len(self.levels), len(PAIRS), L, L), self.unreachable,
+                         dtype=np.int64)
+            for j, level in enumerate(self.levels):
+                for q, table in enumerate(level):
+                    st[j, q, :table.shape[0], :table.shape[1]] = table
+            self._stack = st
+        return self._stack
+
+    def move_shortfalls_batch(self, h: NDArray[np.int64], f: NDArray[np.int64],
+                              g: NDArray[np.int64], p_f: NDArray[np.int64],
+                              p_g: NDArray[np.int64], k: NDArray[np.int64],
+                              mask: NDArray[np.bool_], rot_delta: NDArray[np.int64]
+                              ) -> NDArray[np.float32]:
+        """:meth:`move_shortfalls` of ``N`` states at once: ``(N, (2 P + 2 R) D)`` float32.
+
+        ``h, f, g, p_f, p_g, k`` are ``(N,)`` integer arrays (free finger, held fingers
+        ``f < g`` and their workspace positions, object angle), ``mask`` is ``(N, A)``.
+        Row ``i`` is the look-ahead of state ``i``:
+
+        - regrasp ``(p, l)`` (the free finger to workspace position ``p``, lift ``l``):
+          the reach shortfall of the grasp it makes, ``j = 0 .. D - 1`` more regrasps
+          deep, from ``levels[j]`` of the pair (kept finger, ``h``) at the kept contact
+          and ``h``'s new one;
+        - rotation ``a``: of the regrasps legal at the angle it leads to, the one falling
+          least short at ``j = D - 1``, then ``D - 2``, ... (ties: the lower lift, then the
+          lower position); 0 when the rotation itself reaches the turn;
+        - an illegal move, a position outside ``h``'s workspace or a contact outside the
+          search window: ``abs(K) - unreachable``, the "none" value.
         """
         model, D = self.model, self.depth + 1
         K, sign, seg, P = abs(self.turn_steps), self._sign, self._seg, int(model.P)
         none = K - self.unreachable  # the shortfall written for "no such move"
-        R2 = rot_delta.size
-        W_h = int(model.ws_width[h])
-        ks = k + np.concatenate(([0], rot_delta))  # object angle now, and after each rotation
-        q = np.arange(W_h)
-        best = np.full((2, D, R2 + 1, W_h), none, dtype=np.int64)
-        x0h = seg.x0[h]
-        ih = (int(model.ws_start[h]) - x0h) + q[None, :] - ks[:, None]  # h's contact index
-        inside_h = (ih >= 0) & (ih < seg.L[h])
-        ih = np.clip(ih, 0, seg.L[h] - 1)
+        stack = self._stacked_levels()
+        N, R2 = h.size, rot_delta.size
+        x0 = np.asarray(seg.x0, dtype=np.int64)
+        Lf = np.asarray(seg.L, dtype=np.int64)
+        ws_start = np.asarray(model.ws_start, dtype=np.int64)
+        q = np.arange(P)
+        # object angle now, and after each rotation: (N, R2 + 1)
+        ks = k[:, None] + np.concatenate(([0], rot_delta))[None, :]
+        # h's contact index at each position of its workspace: (N, R2 + 1, P)
+        ih = ((ws_start[h] - x0[h])[:, None, None] + q[None, None, :] - ks[:, :, None])
+        inside_h = ((ih >= 0) & (ih < Lf[h][:, None, None])
+                    & (q[None, None, :] < np.asarray(model.ws_width)[h][:, None, None]))
+        ih = np.clip(ih, 0, Lf[h][:, None, None] - 1)
+        best = np.empty((2, D, N, R2 + 1, P), dtype=np.int64)
+        L = stack.shape[2]
+        flat = stack.reshape(-1)  # flat gathers: one np.take per lift and depth
         for lift, (keep, p_keep) in enumerate(((g, p_g), (f, p_f))):  # l = 0 lifts f, keeps g
-            pair = _pair_index(keep, h)
-            ik = int(model.ws_start[keep]) + p_keep - k - seg.x0[keep]
-            if not 0 <= ik < seg.L[keep]:
-                continue
+            pair = (keep + h - 1)  # PAIRS order (0, 1), (0, 2), (1, 2): index a + b - 1
+            ik = ws_start[keep] + p_keep - k - x0[keep]
+            ok = (ik >= 0) & (ik < Lf[keep])
+            ik = np.clip(ik, 0, Lf[keep] - 1)
+            # the table's rows are the pair's lower finger: (keep, h) or (h, keep)
+            lower = keep < h
+            at = (pair * L * L + np.where(lower, ik * L, ik))[:, None, None] \
+                + np.where(lower[:, None, None], ih, ih * L)
+            unusable = ~(inside_h & ok[:, None, None])
             for j in range(D):
-                table = self.levels[j][pair]
-                v = table[ik, ih] if keep < h else table[ih, ik]
-                best[lift, j] = np.where(inside_h, np.maximum(K - v, 0), none)
-        A = mask.size
-        out = np.empty((2 * P + R2) * D, dtype=np.float32)
-        regrasp = np.full((P, 2, D), none, dtype=np.int64)
-        regrasp[:W_h] = best[:, :, 0, :].transpose(2, 0, 1)  # [q, lift, j]
-        legal = mask[A - 2 * P:].reshape(P, 2)
+                v = flat.take(at + j * 3 * L * L)
+                np.subtract(K, v, out=v)
+                np.maximum(v, 0, out=v)
+                v[unusable] = none
+                best[lift, j] = v
+        A = mask.shape[1]
+        # regrasps: [N, q, lift, j]; illegal ones (the mask) read none
+        regrasp = best[:, :, :, 0, :].transpose(2, 3, 0, 1).copy()
+        legal = mask[:, A - 2 * P:].reshape(N, P, 2)
         regrasp[~legal] = none
-        out[:2 * P * D] = regrasp.reshape(-1)
         # after each rotation, the regrasp that is best first at depth D - 1, then D - 2, ...
-        cand = best[:, :, 1:, :].transpose(2, 0, 3, 1).reshape(R2, 2 * W_h, D)  # [rot, c, j]
-        key = (cand * (none + 1) ** np.arange(D)).sum(axis=2)
-        rot = cand[np.arange(R2), key.argmin(axis=1)]  # [rot, j]
-        rot[sign * ks[1:] >= K] = 0  # the rotation itself reaches the turn
-        rot[~mask[:R2]] = none
-        out[2 * P * D:] = rot.reshape(-1)
+        cand = best[:, :, :, 1:, :].transpose(2, 3, 0, 4, 1).reshape(N, R2, 2 * P, D)
+        key = (cand * (none + 1) ** np.arange(D)).sum(axis=3)
+        rot = np.take_along_axis(cand, key.argmin(axis=2)[:, :, None, None], axis=2)[:, :, 0]
+        rot[sign * ks[:, 1:] >= K] = 0  # the rotation itself reaches the turn
+        rot[~mask[:, :R2]] = none
+        out = np.empty((N, (2 * P + R2) * D), dtype=np.float32)
+        out[:, :2 * P * D] = regrasp.reshape(N, -1)
+        out[:, 2 * P * D:] = rot.reshape(N, -1)
         out /= K
         return out
 

@@ -61,11 +61,21 @@ def test_batched_env_only_where_it_reproduces_the_env():
     assert batched_eval_env("GraspGaitRandom-v0", {}) is None
     assert batched_eval_env("GraspGait-v0", {"object": "circle"},
                             ("graspgait_env.agents.wrappers:LegalActionWrapper",)) is None
-    # a field the batched step does not implement: played one by one, never refused
-    assert batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 2}) is None
-    # ... but at its default it changes nothing, and the batched env applies
-    venv = batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 0}, (), 5)
+    # every config field is batched now, the reach look-ahead included
+    venv = batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 2}, (), 5)
     assert venv.num_envs == 5
+
+
+def test_a_field_the_batched_env_lacks_is_played_one_by_one(monkeypatch):
+    """Should a config field be missing from the batched step, evaluation does not refuse
+    it: it plays single envs (simulated by withdrawing a field from the batched list)."""
+    from graspgait_env.envs import vector_env
+
+    monkeypatch.setattr(vector_env, "SUPPORTED_FIELDS",
+                        vector_env.SUPPORTED_FIELDS - {"regrasp_lookahead"})
+    assert batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 2}) is None
+    assert batched_eval_env("GraspGait-v0", {"object": "circle", "regrasp_lookahead": 0},
+                            (), 2) is not None  # at its default it changes nothing
 
 
 def test_evaluate_sampled_actions_stay_one_by_one(smoke_run):

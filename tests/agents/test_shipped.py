@@ -148,16 +148,22 @@ def test_import_paths_of_0_1_are_upgraded():
     assert cfg.policy == "graspgait_env.agents.policies:MaskableRegraspScorerPolicy"
 
 
-def test_evaluate_random_on_an_object_file_plays_single_envs(tmp_path, monkeypatch):
-    """The batched path refuses the look-ahead, so evaluation falls back by itself; the
-    records equal those of the single-env loop (they are that loop)."""
+def test_evaluate_random_on_an_object_file_runs_batched_as_the_single_envs(tmp_path,
+                                                                          monkeypatch):
+    """The look-ahead of ``random`` is batched: evaluation on an object file plays the
+    episodes side by side, with the records of the single-env loop."""
     import graspgait_env.agents.evaluate as ev
 
-    calls = []
-    real = ev.run_episodes
-    monkeypatch.setattr(ev, "run_episodes", lambda *a, **k: calls.append(1) or real(*a, **k))
     path = tmp_path / "kite.yaml"
     path.write_text(KITE)
-    res = evaluate("random", object=str(path), episodes=2)
-    assert calls == [1] and len(res["episodes"]) == 2
-    assert np.isfinite(res["wall_s"])
+    batched = evaluate("random", object=str(path), episodes=3)
+    calls = []
+    monkeypatch.setattr(ev, "batched_eval_env", lambda *a, **k: calls.append(1))  # None
+    serial = evaluate("random", object=str(path), episodes=3)
+    assert calls == [1]
+
+    def strip(records):
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in records]
+
+    assert strip(batched["episodes"]) == strip(serial["episodes"])
+    assert np.isfinite(batched["wall_s"])

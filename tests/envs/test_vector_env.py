@@ -119,6 +119,10 @@ def test_same_transitions_at_the_registered_time_limit():
     {"forbid_revisit": True, "turn_deg": 60.0},
     {"forbid_revisit": True, "forbid_reversal": True, "contact_model": "hand",
      "object": "hexagon", "to_go_weight": 1.0, "turn_deg": 40.0},
+    {"regrasp_lookahead": 3, "turn_deg": 60.0},
+    {"regrasp_lookahead": 1, "contact_model": "hand", "object": "hexagon", "turn_deg": -40.0},
+    {"regrasp_lookahead": 2, "forbid_revisit": True, "forbid_reversal": True,
+     "rotation_lookahead": True, "map_lines": True, "n": 90, "turn_deg": 90.0},
 ])
 def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
@@ -216,7 +220,7 @@ def test_an_unimplemented_config_field_is_refused_by_name(monkeypatch):
 
 # A valid value off the default for each config field the batched step does not
 # implement; a new such field without an entry here fails the test below.
-OFF_DEFAULT = {"regrasp_lookahead": 2}
+OFF_DEFAULT: dict[str, object] = {}
 
 
 def test_new_config_fields_are_listed_or_refused():
