@@ -122,7 +122,15 @@ def test_off_by_default_and_checked():
             gym.make("graspgait_env:GraspGait-v0", regrasp_lookahead=bad)
 
 
-def test_batched_env_refuses_the_field():
-    with pytest.raises(GraspGaitInputError, match="regrasp_lookahead"):
-        gym.make_vec("graspgait_env:GraspGait-v0", num_envs=2,
-                     vectorization_mode="vector_entry_point", regrasp_lookahead=2)
+def test_batched_env_writes_the_single_envs_lookahead():
+    """The batched env implements the field: each row's reach look-ahead is the single
+    env's for the same seed (the same function, RegraspReach.move_shortfalls_batch)."""
+    venv = gym.make_vec("graspgait_env:GraspGait-v0", num_envs=2,
+                        vectorization_mode="vector_entry_point", regrasp_lookahead=2)
+    obs, _ = venv.reset(seed=5)
+    reach = venv.unwrapped.layout.reach
+    assert reach.stop > reach.start
+    for i in range(2):
+        single = gym.make("graspgait_env:GraspGait-v0", regrasp_lookahead=2)
+        o, _ = single.reset(seed=5 + i)
+        np.testing.assert_array_equal(obs[i, reach], o[reach])
