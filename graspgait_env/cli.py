@@ -14,6 +14,9 @@
     graspgait evaluate MODEL|NAME [--object OBJECT] [--mu MU] [--episodes N] | --list
     graspgait story [MODEL|NAME] [--object OBJECT] [--start PHI1,PHI2] [--out DIR] | --list
     graspgait config [KIND [NAME]]
+    graspgait benchmark POLICY [--tasks T,...] [--seeds 0-4] [--episodes N] [--ray [ADDRESS]]
+                        [--out DIR] [--csv F] [--json F] [--md F] [--png F] | --list-tasks
+    graspgait dataset record TASK [--policy optimal|rule] [--episodes N] [--overwrite]
 
 Every subcommand's ``--help`` shows its defaults, examples and, for the long ones, a
 rough duration. Exit status: 0 on success; 2 on bad input (an argument, a file, a
@@ -1028,6 +1031,170 @@ def _add_config(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_config)
 
 
+# --- benchmark ------------------------------------------------------------------------
+
+
+def _cmd_benchmark(args: argparse.Namespace) -> int:
+    _require("benchmark", "graspgait benchmark")
+    from graspgait_env.benchmark.suite import format_suite, parse_tasks
+
+    if args.list_tasks:
+        tasks = parse_tasks(args.tasks)
+        print(format_suite(tasks))
+        if args.json:
+            import json
+
+            from graspgait_env.atomic import write_text_atomic
+
+            text = json.dumps([t.to_dict() for t in tasks], indent=1) + "\n"
+            _write_output("--json", args.json, lambda: write_text_atomic(args.json, text))
+            print(f"wrote {args.json}")
+        return 0
+    if args.policy is None:
+        raise GraspGaitInputError("POLICY missing: give random, a planner (e.g. rule), "
+                                  "greedy-reach, agent:NAME, a model .zip, config:NAME or bc; "
+                                  f"`{PROG} benchmark --list-tasks` lists the tasks")
+    from graspgait_env.baselines.scale_out import parse_seeds
+    from graspgait_env.benchmark.policies import parse_policy
+
+    spec = parse_policy(args.policy)
+    if spec.kind in ("agent", "agent-template", "config", "bc"):
+        _require("train", f"graspgait benchmark {args.policy}")
+    _require_ray(args, "graspgait benchmark")
+    tasks = parse_tasks(args.tasks)
+    seeds = parse_seeds(args.seeds)
+    if args.episodes is not None and args.episodes < 1:
+        raise GraspGaitInputError(f"--episodes {args.episodes}: must be >= 1, e.g. 10")
+    _check_outputs(args, {"csv": (".csv",), "json": (".json",), "md": (".md",)})
+    _check_outputs(args, {"png": _figure_suffixes()})
+    from graspgait_env.benchmark.run import run_benchmark
+
+    command = " ".join([PROG, "benchmark", args.policy, "--tasks", args.tasks or "all",
+                        "--seeds", args.seeds]
+                       + (["--episodes", str(args.episodes)] if args.episodes else [])
+                       + (["--reps", str(args.reps)] if args.reps != 2000 else []))
+    if args.reps < 100:
+        raise GraspGaitInputError(f"--reps {args.reps}: must be >= 100, e.g. 2000")
+    result = run_benchmark(spec, tasks, seeds, out_dir=args.out, episodes=args.episodes,
+                           ray=args.ray, progress=not args.quiet, command=command,
+                           reps=args.reps)
+    import shutil
+    from pathlib import Path
+
+    print(Path(result["files"]["md"]).read_text(encoding="utf-8"), end="")
+    print(f"wrote {', '.join(result['files'].values())}")
+    for flag in ("csv", "json", "md", "png"):
+        dest = getattr(args, flag)
+        if dest and flag in result["files"]:
+            _write_output(f"--{flag}", dest, lambda f=flag, d=dest: shutil.copyfile(
+                result["files"][f], d))
+            print(f"wrote {dest}")
+    for label, error in result["failures"]:
+        _error(f"benchmark cell {label} failed: {error}")
+    return 1 if result["failures"] else 0
+
+
+def _add_benchmark(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("benchmark", help="score a policy on the benchmark suite over seeds",
+                       description="Run POLICY on the tasks of the GraspGait benchmark suite "
+                       "(the thesis objects with point contacts and the hand's contact model, "
+                       "held-out procedural objects at levels 0-3, the simulated hand from "
+                       "perturbed poses and below the planning friction), one run per seed, "
+                       "and score each run: success over the starts from which a gait exists, "
+                       "efficiency (the optimum's regrasps over the policy's), and their "
+                       "product, the normalized score, beside the rule-based gait's. "
+                       "Aggregates with rliable: per-task mean and IQM, per-track and suite "
+                       "IQM, 95% stratified bootstrap confidence intervals, a performance "
+                       "profile. The row's folder (--out) keeps one file per task and seed: "
+                       "run it again to resume. POLICY: random (masked), a planner, "
+                       "greedy-reach (the reach look-ahead read greedily), agent:NAME or a "
+                       "model .zip, config:NAME or a training config .yaml (trained once per "
+                       "task and seed), bc[:optimal|rule] (behaviour cloning from `graspgait "
+                       "dataset record`). Needs the [benchmark] extra (and [train] for "
+                       "agents, configs and bc).",
+                       epilog=_epilog(["benchmark --list-tasks",
+                                       "benchmark random --tasks map-point-circle,random-l0 "
+                                       "--seeds 0-1 --episodes 3",
+                                       "benchmark rule --tasks map-point,random",
+                                       "benchmark greedy-reach --json row.json --md row.md",
+                                       "benchmark agent:random --tasks random --ray",
+                                       "benchmark config:ellipse --tasks map-hand-ellipse"],
+                                      duration="seconds for the example with --episodes 3; "
+                                      "7-21 min for a planner or random over the whole suite "
+                                      "and 5 seeds (the hand track: 1-10 s per episode); "
+                                      "hours for a training config"))
+    p.add_argument("policy", metavar="POLICY", nargs="?",
+                   help="random, a planner name, greedy-reach, agent:NAME or a model .zip "
+                   "({task}, {train_task}, {seed} in its path: one model per task and "
+                   "seed), "
+                   "config:NAME or a config .yaml, bc[:optimal|rule]")
+    p.add_argument("--list-tasks", action="store_true",
+                   help="print the suite (or the tasks of --tasks) and exit")
+    p.add_argument("--tasks", metavar="T,...", help="task ids and track names (map-point, "
+                   "map-hand, random, mujoco), comma-separated (default: every task)")
+    p.add_argument("--seeds", default="0-4", help="run seeds, e.g. 0-4 or 0,3 (default 0-4)")
+    p.add_argument("--episodes", type=int, help="test episodes per run (default: each task's "
+                   "budget, 40 at map level, 5 on the simulated hand)")
+    p.add_argument("--out", metavar="DIR", help="the row's folder: one file per task and "
+                   "seed, cells.csv, result.json, result.md, profile.png (default "
+                   "benchmark/LABEL, LABEL from POLICY)")
+    _add_ray_option(p, "run one Ray task per task and seed; same scores as serially")
+    p.add_argument("--reps", type=int, default=2000, help="bootstrap replications of every "
+                   "confidence interval (default 2000; the resampling is seeded, so a row's "
+                   "intervals are reproducible)")
+    p.add_argument("--csv", metavar="FILE", help="also write the per-run CSV here")
+    p.add_argument("--json", metavar="FILE", help="also write the result JSON here (with "
+                   "--list-tasks: the suite)")
+    p.add_argument("--md", metavar="FILE", help="also write the Markdown tables here")
+    p.add_argument("--png", metavar="FILE", help="also write the performance profile here")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_benchmark)
+
+
+# --- dataset --------------------------------------------------------------------------
+
+
+def _cmd_dataset(args: argparse.Namespace) -> int:
+    _require("benchmark", "graspgait dataset")
+    from graspgait_env.benchmark.datasets import datasets_path, record_dataset
+
+    if args.episodes < 1:
+        raise GraspGaitInputError(f"--episodes {args.episodes}: must be >= 1, e.g. 100")
+    ds = record_dataset(args.task, args.policy, args.episodes, overwrite=args.overwrite,
+                        progress=not args.quiet)
+    print(f"recorded {ds.id}: {ds.total_episodes} episodes, {ds.total_steps} steps, in "
+          f"{datasets_path()} (minari.load_dataset({ds.id!r}))")
+    return 0
+
+
+def _add_dataset(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("dataset", help="record demonstrations of a benchmark task (Minari)",
+                       description="record: a planner (the exact optimum or the rule-based "
+                       "method) plays a benchmark task's training env through Minari's "
+                       "DataCollector, from the training reset seeds 0, 1, ... (a start "
+                       "without a gait is skipped), and the dataset is written to Minari's "
+                       "data path (MINARI_DATASETS_PATH, else ~/.minari/datasets) as "
+                       "graspgait/TASK/POLICY-vN (N: the suite's version), with the env "
+                       "spec, the test env as eval_env and the planner as expert_policy. "
+                       "Load it with minari.load_dataset; `graspgait benchmark bc` clones it. "
+                       "Needs the [benchmark] extra.",
+                       epilog=_epilog(["dataset record map-point-ellipse --episodes 10",
+                                       "dataset record random-l1 --policy rule --episodes 200",
+                                       "dataset record map-hand-hexagon --overwrite"],
+                                      duration="about 10 s for 10 episodes; a minute or two "
+                                      "for 200 (the optimum's search per start)"))
+    p.add_argument("action", choices=["record"], help="record: record demonstrations")
+    p.add_argument("task", metavar="TASK", help="a task id (`graspgait benchmark "
+                   "--list-tasks`); the hand track's tasks learn on their map-hand twin")
+    p.add_argument("--policy", choices=["optimal", "rule"], default="optimal",
+                   help="the demonstrating planner (default optimal)")
+    p.add_argument("--episodes", type=int, default=100, help="demonstrations (default 100)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a dataset of the same id")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_dataset)
+
+
 # --- registry -------------------------------------------------------------------------
 # Later subcommands (plan, bench, simulate, train) are added HERE: write
 # `_cmd_X(args) -> int` and `_add_X(sub)` as above and append `_add_X` below. Register
@@ -1043,6 +1210,8 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_evaluate,
     _add_story,
     _add_config,
+    _add_benchmark,
+    _add_dataset,
 ]
 
 

@@ -4,19 +4,22 @@ line that names a missing one.
 The base install gives the map-level library, the MuJoCo hand and every Gymnasium env.
 The rest comes in extras:
 
-==========  ============================================================================
-extra       what it adds, and what needs it
-==========  ============================================================================
-``train``   torch (a lower bound, never a pin), stable-baselines3, sb3-contrib and
-            TensorBoard: ``graspgait train``, ``evaluate``, ``story``, the agents of
-            ``bench``, :mod:`graspgait_env.agents`
-``ray``     Ray (Tune): every ``--ray`` option
-``zoo``     RL Zoo (``rl_zoo3``), with ``train``: plain PPO with the bundled
-            hyper-parameters (``graspgait config rlzoo``)
-``video``   imageio with its ffmpeg plugin, and moviepy (which Gymnasium's
-            ``RecordVideo`` needs): ``graspgait simulate --video``, recorded videos
-``all``     every extra above
-==========  ============================================================================
+=============  =========================================================================
+extra          what it adds, and what needs it
+=============  =========================================================================
+``train``      torch (a lower bound, never a pin), stable-baselines3, sb3-contrib and
+               TensorBoard: ``graspgait train``, ``evaluate``, ``story``, the agents of
+               ``bench``, :mod:`graspgait_env.agents`
+``ray``        Ray (Tune): every ``--ray`` option
+``zoo``        RL Zoo (``rl_zoo3``), with ``train``: plain PPO with the bundled
+               hyper-parameters (``graspgait config rlzoo``)
+``video``      imageio with its ffmpeg plugin, and moviepy (which Gymnasium's
+               ``RecordVideo`` needs): ``graspgait simulate --video``, recorded videos
+``benchmark``  rliable (IQM, stratified bootstrap intervals, performance profiles) and
+               Minari with Arrow files and jax (its ``DataCollector``): ``graspgait
+               benchmark``, ``graspgait dataset``, :mod:`graspgait_env.benchmark`
+``all``        every extra above
+=============  =========================================================================
 
 This module imports none of them: it asks :func:`importlib.util.find_spec` whether they
 are there, so it belongs to the pure-NumPy core.
@@ -39,6 +42,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "ray": ("ray",),
     "zoo": ("rl_zoo3",),
     "video": ("imageio", "imageio_ffmpeg", "moviepy"),
+    "benchmark": ("rliable", "minari", "pyarrow", "jax"),
 }
 
 
@@ -83,7 +87,8 @@ def require_extra(extra: str, what: str) -> None:
     Parameters
     ----------
     extra
-        A key of :data:`EXTRAS` (``"train"``, ``"ray"``, ``"zoo"``, ``"video"``).
+        A key of :data:`EXTRAS` (``"train"``, ``"ray"``, ``"zoo"``, ``"video"``,
+        ``"benchmark"``).
     what
         What needs it, as the message's subject (``"graspgait train"``).
 

@@ -76,11 +76,12 @@ def test_every_core_module_is_in_a_layer() -> None:
     modules = {p.stem for p in pkg.glob("*.py")} - {"__init__"} - COMPOSITION_ROOTS
     missing = sorted(f"graspgait_env.{m}" for m in modules if f"graspgait_env.{m}" not in named)
     assert not missing, f"add {missing} to a layer of the import-linter contract"
-    for sub in ("planners", "sim", "envs"):
+    for sub in ("planners", "sim", "envs", "benchmark"):
         assert f"graspgait_env.{sub}" in named
 
 
 def test_the_layers_run_in_the_documented_order() -> None:
     layers = next(c for c in _contracts() if c["type"] == "layers")["layers"]
-    assert layers[:5] == ["graspgait_env.agents", "graspgait_env.baselines",
-                          "graspgait_env.envs", "graspgait_env.sim", "graspgait_env.planners"]
+    assert layers[:6] == ["graspgait_env.benchmark", "graspgait_env.agents",
+                          "graspgait_env.baselines", "graspgait_env.envs", "graspgait_env.sim",
+                          "graspgait_env.planners"]

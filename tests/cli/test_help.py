@@ -14,7 +14,8 @@ import graspgait_env.extras as extras
 from graspgait_env.cli import build_parser, main
 from graspgait_env.resources import KINDS, bundled_file, bundled_names
 
-LONG = {"train", "bench", "perf", "simulate", "evaluate", "sweep", "story"}
+LONG = {"train", "bench", "perf", "simulate", "evaluate", "sweep", "story", "benchmark",
+        "dataset"}
 # a path that only a clone has: a folder of the repository followed by a file or folder
 CLONE_PATH = re.compile(r"\b(configs|docs|agents|baselines|tests)/[\w.<>{}-]")
 
@@ -32,7 +33,7 @@ def _help(capsys, *argv: str) -> str:
 
 def test_every_subcommand_is_covered():
     assert set(_subparsers()) == {"map", "sweep", "plan", "bench", "simulate", "perf", "train",
-                                  "evaluate", "story", "config"}
+                                  "evaluate", "story", "config", "benchmark", "dataset"}
 
 
 @pytest.mark.parametrize("command", sorted(_subparsers()))
@@ -126,6 +127,8 @@ def without(monkeypatch):
     (["bench", "--starts", "1"], "train"),
     (["bench", "--starts", "1", "--agents", "none", "--ray"], "ray"),
     (["simulate", "plan.json", "--video", "v.mp4"], "video"),
+    (["benchmark", "--list-tasks"], "benchmark"),
+    (["dataset", "record", "map-point-circle"], "benchmark"),
 ])
 def test_a_command_names_its_missing_extra_in_one_line(argv, extra, without, capsys,
                                                        tmp_path, monkeypatch):

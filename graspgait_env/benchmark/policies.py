@@ -1,0 +1,358 @@
+"""What ``graspgait benchmark POLICY`` runs: POLICY resolved into a policy per task and seed.
+
+POLICY is one of:
+
+- ``random``: the masked random policy, a legal move drawn uniformly at every step
+  (NumPy generator seeded by the run seed);
+- a planner name of :data:`graspgait_env.planners.registry.PLANNERS` (``rule``,
+  ``optimal``, ``best-first``, ...), run as a policy by
+  :class:`graspgait_env.baselines.policies.PlannerPolicy` (it plans from the episode's
+  start, follows the plan while the state is the one it expects, replans otherwise);
+- ``greedy-reach``: a scripted greedy reading of the reach look-ahead, no learning: the
+  env gives each move the shortfall of the turn after the best chain of up to 2 more
+  regrasps (``regrasp_lookahead=3``, :class:`graspgait_env.planners.reach.RegraspReach`)
+  and the policy plays a rotation that completes the turn when one is legal, else the
+  move falling least short at depth 2, then 1, then 0 (ties: a regrasp before a
+  rotation, a shorter rotation first), with ``forbid_revisit=True``
+  (tests/envs/test_regrasp_lookahead.py);
+- ``agent:NAME`` or a model path (``.zip``; also a bare shipped agent name other than
+  ``random``): a saved agent (:func:`graspgait_env.agents.card.load_agent`), played
+  greedily with the observation settings of its card; a path with ``{task}``,
+  ``{train_task}`` (the task a hand-track task trains in, else the task) or ``{seed}`` in
+  it names one model per task and run seed (models trained elsewhere, e.g. by RL Zoo:
+  ``logs/{train_task}/s{seed}/ppo/GraspGait-v0_1/GraspGait-v0.zip``);
+- ``config:NAME`` or a training config path (``.yaml``): trained once per task and seed
+  (:func:`graspgait_env.agents.train.train`, ``seed`` = the run seed) in the task's
+  training env, within the task's step budget, then played greedily;
+- ``bc`` or ``bc:POLICY`` (``optimal``, the default, or ``rule``): behaviour cloning,
+  trained per task and seed from the task's demonstrations
+  (:mod:`graspgait_env.benchmark.datasets`; ``graspgait dataset record`` first).
+
+A task fixes the problem's keywords (:data:`~graspgait_env.benchmark.suite.TASK_KEYS`:
+object, mu, contact model, level, object seeds, hand, grid, ...); a policy brings its own
+observation settings and move rules (``map_lines``, ``rotation_lookahead``,
+``regrasp_lookahead``, ``forbid_reversal``, ``forbid_revisit``, ...) and action wrappers
+(a start-distribution wrapper such as ``SolvableStartWrapper`` is dropped: the test
+starts are the task's). Neither move rule changes the fewest regrasps from a start.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from graspgait_env.benchmark.suite import TASK_KEYS, Task, get_task
+from graspgait_env.errors import GraspGaitInputError
+
+__all__ = ["CellPolicy", "PolicySpec", "parse_policy", "prepare_policy", "greedy_reach_predictor",
+           "policy_env_kwargs", "GREEDY_REACH_DEPTH", "START_WRAPPERS"]
+
+Predict = Callable[[np.ndarray, np.ndarray], int]
+GREEDY_REACH_DEPTH = 3
+# wrappers that choose the start grasp: the task chooses it, so they are dropped
+START_WRAPPERS = ("SolvableStartWrapper", "RuleBasedStartWrapper")
+DEMO_POLICIES = ("optimal", "rule")
+
+
+@dataclass(frozen=True)
+class PolicySpec:
+    """A resolved POLICY: ``kind`` (random, planner, greedy-reach, agent, agent-template,
+    config, bc), ``arg`` (the planner, model, model path template, config or
+    demonstrating policy) and ``label`` (its name in tables and the default output
+    folder)."""
+
+    kind: str
+    arg: str
+    label: str
+
+    def to_dict(self) -> dict[str, str]:
+        """``{"kind", "arg", "label"}`` (``PolicySpec(**d)`` makes it again)."""
+        return dataclasses.asdict(self)
+
+
+def _label(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "policy"
+
+
+def parse_policy(text: str) -> PolicySpec:
+    """Resolve POLICY (module docstring) without running anything.
+
+    Raises
+    ------
+    GraspGaitInputError
+        Nothing of that name; the message lists what POLICY may be.
+    """
+    from graspgait_env.planners.registry import PLANNERS
+
+    text = str(text).strip()
+    kind, sep, rest = text.partition(":")
+    if text == "random":
+        return PolicySpec("random", "", "random")
+    if text in PLANNERS:
+        return PolicySpec("planner", text, text)
+    if text == "greedy-reach":
+        return PolicySpec("greedy-reach", "", "greedy-reach")
+    if text == "bc" or (sep and kind == "bc"):
+        demo = rest or "optimal"
+        if demo not in DEMO_POLICIES:
+            raise GraspGaitInputError(f"POLICY {text!r}: bc learns from the demonstrations of "
+                                      f"{' or '.join(DEMO_POLICIES)}, e.g. bc:optimal")
+        return PolicySpec("bc", demo, f"bc-{demo}")
+    if any(f"{{{k}}}" in text for k in ("task", "train_task", "seed")):
+        try:
+            text.format(task="t", train_task="t", seed=0)
+        except (KeyError, IndexError, ValueError):
+            raise GraspGaitInputError(f"POLICY {text!r}: a model path template may name "
+                                      "only {task}, {train_task} and {seed}") from None
+        stem = Path(text.format(task="TASK", train_task="TASK", seed="SEED")).stem
+        return PolicySpec("agent-template", text, f"agent-{_label(stem)}")
+    if sep and kind == "config":
+        _load_config(rest)
+        return PolicySpec("config", rest, f"config-{_label(Path(rest).stem)}")
+    if sep and kind == "agent":
+        return PolicySpec("agent", str(_resolve_model(rest)), f"agent-{_label(Path(rest).stem)}")
+    path = Path(text)
+    if path.suffix in (".yaml", ".yml"):
+        _load_config(text)
+        return PolicySpec("config", str(path), f"config-{_label(path.stem)}")
+    if path.suffix == ".zip" or path.is_file() or text in _shipped():
+        model = _resolve_model(text)
+        stem = path.stem if path.stem != "model" else f"{path.parent.name}-model"
+        return PolicySpec("agent", str(model), f"agent-{_label(stem)}")
+    raise GraspGaitInputError(
+        f"POLICY {text!r}: not a policy; give random, a planner ({', '.join(PLANNERS)}), "
+        "greedy-reach, a shipped agent (agent:NAME, e.g. agent:ellipse) or a model .zip, a "
+        "training config (config:NAME, e.g. config:ellipse, or a .yaml path), or bc[:optimal|"
+        "rule]")
+
+
+def _shipped() -> list[str]:
+    try:
+        from graspgait_env.agents.card import shipped_agents
+
+        return shipped_agents()
+    except ImportError:  # pragma: no cover - the agents package always installs
+        return []
+
+
+def _resolve_model(text: str) -> Path:
+    from graspgait_env.agents.card import resolve_model
+
+    return resolve_model(text)
+
+
+def _load_config(text: str) -> Any:
+    from graspgait_env.agents.config import load_train_config
+
+    return load_train_config(text)
+
+
+def _own_keys(env_id: str, own: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A policy's own keywords that ``env_id`` takes: without the problem's
+    (:data:`~graspgait_env.benchmark.suite.TASK_KEYS`) and without those of another id
+    (``episodes_per_object`` of a ``GraspGaitRandom-v0`` agent on one object)."""
+    from graspgait_env.agents.envs import MUJOCO_ONLY, RANDOM_ONLY
+
+    other = (RANDOM_ONLY if env_id != "GraspGaitRandom-v0" else ()) + (
+        MUJOCO_ONLY if env_id != "GraspGaitMujoco-v1" else ())
+    return {k: v for k, v in dict(own or {}).items() if k not in TASK_KEYS and k not in other}
+
+
+def policy_env_kwargs(task: Task, own: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The test env's keywords for a policy: its own keywords without the problem's
+    (:data:`~graspgait_env.benchmark.suite.TASK_KEYS`) and those the task's id does not
+    take, then the task's."""
+    kw = _own_keys(task.env_id, own)
+    kw.update(task.env_kwargs())
+    return kw
+
+
+class _EpisodeStarts(gym.Wrapper):
+    """Marks the first step of each episode (``fresh``), so a planner policy knows an
+    episode began even when its new start equals the state it expected next."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.fresh = True
+
+    def reset(self, **kwargs: Any) -> Any:
+        self.fresh = True
+        return self.env.reset(**kwargs)
+
+
+@dataclass
+class CellPolicy:
+    """A policy ready for one task and seed.
+
+    ``env_kwargs`` are its own env keywords (merged under the task's by
+    :func:`policy_env_kwargs`), ``wrappers`` its Gymnasium wrappers (import paths);
+    ``make_predict(env)`` gives ``predict(obs, mask) -> action`` for the env built from
+    them; ``info`` says what lies behind it (model, training steps and wall time).
+    """
+
+    env_kwargs: dict[str, Any]
+    wrappers: tuple[str, ...]
+    make_predict: Callable[[gym.Env], Predict]
+    info: dict[str, Any] = field(default_factory=dict)
+    observation_shape: tuple[int, ...] | None = None
+
+    def wrap(self, env: gym.Env) -> gym.Env:
+        """The env as the predictor expects it (an episode-start marker outermost)."""
+        return _EpisodeStarts(env)
+
+
+def _random_predictor(seed: int) -> Callable[[gym.Env], Predict]:
+    def make(env: gym.Env) -> Predict:
+        rng = np.random.default_rng([int(seed), 0x5EED])
+
+        def predict(obs: np.ndarray, mask: np.ndarray) -> int:
+            legal = np.flatnonzero(mask)
+            return int(rng.choice(legal)) if legal.size else 0
+        return predict
+    return make
+
+
+def _planner_predictor(name: str) -> Callable[[gym.Env], Predict]:
+    def make(env: gym.Env) -> Predict:
+        from graspgait_env.baselines.policies import PlannerPolicy
+        from graspgait_env.planners.registry import get_planner
+
+        policy = PlannerPolicy(env, get_planner(name), name=name)
+
+        def predict(obs: np.ndarray, mask: np.ndarray) -> int:
+            start = bool(getattr(env, "fresh", False))
+            if start:
+                env.fresh = False
+            action, _ = policy.predict(obs, episode_start=np.array([start]))
+            return int(action)
+        return predict
+    return make
+
+
+def greedy_reach_predictor(env: gym.Env, depth: int = GREEDY_REACH_DEPTH) -> Predict:
+    """The greedy reading of the reach look-ahead (module docstring) for an env made with
+    ``regrasp_lookahead=depth``: a rotation that completes the turn when one is legal,
+    else the legal move whose shortfall is least at depth ``depth - 1``, then
+    ``depth - 2``, ... (ties: a regrasp before a rotation, a shorter rotation first)."""
+    u = env.unwrapped
+    D = int(depth)
+
+    def predict(obs: np.ndarray, mask: np.ndarray) -> int:
+        model = u.model
+        R, P = model.R, model.P
+        keys = np.asarray(obs)[u.layout.reach].reshape(2 * P + 2 * R, D)[:, ::-1]
+        order = np.concatenate((np.arange(2 * R, 2 * R + 2 * P), np.arange(2 * R)))
+        legal = np.asarray(mask, dtype=bool)[order]
+        if not legal.any():
+            return 0
+        to_go = round(float(obs[u.layout.to_go]) * abs(model.turn_steps(u.config.turn_deg)))
+        finish = legal & (order < R) & (order + 1 >= to_go)  # a rotation reaching the turn
+        if finish.any():
+            return int(order[np.flatnonzero(finish)[0]])
+        size = np.where(order < 2 * R, order % R + 1, 0)
+        best = min((tuple(keys[i]), size[i], i) for i in np.flatnonzero(legal))
+        return int(order[best[2]])
+    return predict
+
+
+def _agent_policy(model_path: str, info: dict[str, Any] | None = None) -> CellPolicy:
+    from graspgait_env.agents.card import load_agent
+    from graspgait_env.agents.evaluate import agent_predictor
+
+    _one_thread()
+    model, card = load_agent(model_path)
+    wrappers = tuple(w for w in card.get("wrappers") or ()
+                     if not any(s in w for s in START_WRAPPERS))
+    predict = agent_predictor(model, deterministic=True)
+    meta = {"model": str(model_path), "algo": card.get("algo"), "steps": card.get("steps"),
+            "train_wall_s": card.get("wall_s"), **(info or {})}
+    return CellPolicy(dict(card.get("env_kwargs") or {}), wrappers, lambda env: predict,
+                      meta, tuple(model.observation_space.shape))
+
+
+def _one_thread() -> None:
+    import torch
+
+    torch.set_num_threads(1)
+
+
+def training_plan(spec: PolicySpec, task: Task, seed: int, workdir: str | Path
+                  ) -> tuple[Task, Path]:
+    """Where a ``config`` POLICY's model for (task, seed) is trained: the task it trains
+    in (``task.train_task`` or the task) and its run folder under ``workdir``."""
+    train_task = get_task(task.train_task) if task.train_task else task
+    return train_task, Path(workdir) / "train" / train_task.id / f"s{int(seed)}"
+
+
+def train_for(spec: PolicySpec, task: Task, seed: int, workdir: str | Path,
+              progress: bool = False) -> Path:
+    """Train ``spec``'s config for (task, seed) unless its model is already there; the
+    model's path. The config's env keywords lose the problem's keys, which the training
+    task's ``train_kwargs`` give; ``seed`` is the run seed.
+
+    Raises
+    ------
+    GraspGaitInputError
+        The config trains for more steps than the task's budget.
+    """
+    from graspgait_env.agents.train import train
+
+    train_task, run_dir = training_plan(spec, task, seed, workdir)
+    model = run_dir / "model.zip"
+    if model.is_file():
+        return model
+    config = configure_training(spec, train_task, seed, workdir)
+    _one_thread()
+    return train(config, run_dir=run_dir, progress=progress).model_path
+
+
+def configure_training(spec: PolicySpec, train_task: Task, seed: int,
+                       workdir: str | Path) -> Any:
+    """The training config of ``spec`` for ``train_task`` and ``seed`` (checked against
+    the task's step budget)."""
+    config = _load_config(spec.arg)
+    if train_task.train_steps <= 0:
+        raise GraspGaitInputError(f"task {train_task.id}: not a training task")
+    if config.total_timesteps > train_task.train_steps:
+        raise GraspGaitInputError(
+            f"config {spec.arg!r}: total_timesteps={config.total_timesteps:,} exceeds task "
+            f"{train_task.id}'s budget of {train_task.train_steps:,} steps; lower it in the "
+            "config")
+    kw = _own_keys(train_task.train_env_id, config.env_kwargs)
+    kw.update(train_task.train_kwargs)
+    return dataclasses.replace(config, env_id=train_task.train_env_id, env_kwargs=kw,
+                               seed=int(seed), run_root=str(Path(workdir) / "train"))
+
+
+def prepare_policy(spec: PolicySpec, task: Task, seed: int, workdir: str | Path,
+                   progress: bool = False) -> CellPolicy:
+    """The policy of ``spec`` for one task and run seed (training it first for a
+    ``config``, cloning the demonstrations for ``bc``)."""
+    if spec.kind == "random":
+        return CellPolicy({}, (), _random_predictor(seed))
+    if spec.kind == "planner":
+        return CellPolicy({}, (), _planner_predictor(spec.arg), {"planner": spec.arg})
+    if spec.kind == "greedy-reach":
+        return CellPolicy({"regrasp_lookahead": GREEDY_REACH_DEPTH, "forbid_revisit": True}, (),
+                          greedy_reach_predictor, {"depth": GREEDY_REACH_DEPTH})
+    if spec.kind == "agent":
+        return _agent_policy(spec.arg)
+    if spec.kind == "agent-template":
+        path = spec.arg.format(task=task.id, train_task=task.train_task or task.id,
+                               seed=int(seed))
+        return _agent_policy(str(_resolve_model(path)), {"template": spec.arg})
+    if spec.kind == "config":
+        model = train_for(spec, task, seed, workdir, progress=progress)
+        return _agent_policy(str(model), {"config": spec.arg})
+    if spec.kind == "bc":
+        from graspgait_env.benchmark.datasets import bc_policy_for
+
+        return bc_policy_for(task, spec.arg, seed, workdir)
+    raise GraspGaitInputError(f"policy kind {spec.kind!r}: unknown")  # pragma: no cover
