@@ -9,7 +9,7 @@ TORCH_VERSION ?= 2.13.0
 export MPLBACKEND := Agg
 export MUJOCO_GL ?= egl
 
-.PHONY: demo test test-all lint perf bench clean
+.PHONY: demo test test-all lint perf bench docs gallery clean
 
 $(STAMP): pyproject.toml
 	@echo "==> creating the virtual environment $(VENV)"
@@ -20,8 +20,8 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --progress-bar on 'torch==$(TORCH_VERSION)'
 	@echo "==> installing graspgait_env with every extra into $(VENV) (NumPy, MuJoCo, Gymnasium;"
 	@echo "    [train] stable-baselines3, sb3-contrib, TensorBoard; [ray]; [zoo]; [video]; [dev]"
-	@echo "    test tools; about a minute on a fresh machine)"
-	$(BIN)/python -m pip install --progress-bar on -e '.[all,dev]' 'torch==$(TORCH_VERSION)'
+	@echo "    test tools; [docs] the documentation site; about a minute on a fresh machine)"
+	$(BIN)/python -m pip install --progress-bar on -e '.[all,dev,docs]' 'torch==$(TORCH_VERSION)'
 	touch $(STAMP)
 	@echo "==> $(VENV) is ready"
 
@@ -59,5 +59,27 @@ lint: $(STAMP)
 perf: $(STAMP)
 	$(BIN)/graspgait perf
 
+# the documentation site (mkdocs.yml, docs/) into site/, strict: a broken link, a missing
+# page or a reference to a renamed function fails the build
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
+
+# docs/gallery/: grasp maps, gait figures and the learned gaits on the MuJoCo hand
+# (the commands docs/gallery.md names; about two minutes)
+GALLERY_OBJECTS := circle ellipse pentagon hexagon
+gallery: $(STAMP)
+	mkdir -p docs/gallery out/gallery
+	for o in $(GALLERY_OBJECTS); do \
+		$(BIN)/graspgait map $$o --mu 0.7 --png docs/gallery/$${o}_map.png || exit 1; \
+		$(BIN)/graspgait story $$o --out out/gallery || exit 1; \
+		cp out/gallery/$${o}_story.png docs/gallery/$${o}_story.png; \
+		$(BIN)/graspgait simulate out/gallery/$${o}_learned_plan.json \
+			--video docs/gallery/$${o}_learned.mp4 --quiet || exit 1; \
+	done
+	$(BIN)/graspgait map ellipse --mu 0.7 --theta 30 --png docs/gallery/ellipse_map_theta30.png
+	$(BIN)/graspgait sweep eccentricity --png docs/gallery/sweep_eccentricity.png
+	$(BIN)/graspgait plan pentagon --mu 0.7 --planner optimal --start 50,270 --point-contacts \
+		--json out/gallery/pentagon_fig46_plan.json --png docs/gallery/pentagon_fig46_gait.png
+
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out site .pytest_cache

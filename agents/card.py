@@ -229,6 +229,9 @@ def _is_maskable(path: Path) -> bool:
 def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple[Any, dict]:
     """Load a saved agent and its card.
 
+    The algorithm is read from the zip: MaskablePPO when its policy class is a maskable
+    one, else PPO (the returned card's ``algo`` says which).
+
     Parameters
     ----------
     model_path
@@ -238,9 +241,6 @@ def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple
         (:mod:`graspgait_env.agents.legacy`).
     device
         The torch device of the model.
-
-    The algorithm is read from the zip: MaskablePPO when its policy class is a maskable
-    one, else PPO (the returned card's ``algo`` says which).
 
     Returns
     -------

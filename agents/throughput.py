@@ -11,7 +11,7 @@ default) and seed:
   the greedy policy succeeds in ``target`` (95%) of the evaluation episodes: every
   ``eval_every`` steps, ``eval_episodes`` episodes from the starts of training's
   periodic evaluation (reset seeds ``EVAL_SEED + i``), played together in one batched
-  env, each until its first episode ends. Measured once; the README gives the command
+  env, each until its first episode ends. Measured once; docs/scale-out.md gives the command
   (``python -m graspgait_env.agents.throughput``) and the figures.
 
 Both vector envs give the same transitions for the same seeds, so the two runs learn the

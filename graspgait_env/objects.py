@@ -191,7 +191,7 @@ def resolve_object_path(name_or_path: str | Path) -> Path:
     """The YAML path for a bundled object name or a path; refuse names that are neither."""
     s = str(name_or_path)
     path = Path(s)
-    if s.endswith((".yaml", ".yml")) or path.exists():
+    if s.endswith((".yaml", ".yml")) or path.is_file():  # a folder named "circle" is no object
         return path
     bundled = bundled_file("objects", s)
     if bundled is None:

@@ -44,6 +44,31 @@ def _env() -> dict[str, str]:
     return {**os.environ, "MPLBACKEND": "Agg", "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
 
 
+MAX_LINES = 200  # a screen's worth: the rest is in the documentation site (docs/)
+# the project's history lives in CHANGELOG.md; the README says what is, not what was
+HISTORY_WORDS = ("was ", "were ", "previously", "this session", "earlier run",
+                 "load average", "used to ", "no longer", "at the time")
+
+
+def test_readme_is_short_and_holds_no_history() -> None:
+    lines = README.splitlines()
+    assert len(lines) <= MAX_LINES, f"README.md has {len(lines)} lines; move some to docs/"
+    found = [(n, w) for n, line in enumerate(lines, 1) for w in HISTORY_WORDS
+             if w in line.lower()]
+    assert not found, f"history in README.md (line, word): {found}; it belongs in CHANGELOG.md"
+
+
+def test_readme_links_point_into_the_repository() -> None:
+    """Every link of the README is a file of the repository (the documentation site's
+    sources), never an address outside it."""
+    links = re.findall(r"\]\(([^)\s]+)\)", README)
+    assert len(links) >= 10
+    for link in links:
+        assert "://" not in link, f"README.md links outside the repository: {link}"
+        path = (ROOT / link.split("#")[0]).resolve()
+        assert path.exists() and ROOT in path.parents, f"README.md: no such file {link}"
+
+
 def test_readme_has_what_this_test_runs() -> None:
     assert len(_blocks("python")) >= 2
     assert len(_commands()) >= 6

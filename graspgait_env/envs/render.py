@@ -99,14 +99,14 @@ def _trail_points(model: GaitModel, trail: Sequence[tuple[int, tuple[int, ...]]]
 class GaitFrames:
     """Frames of one gait model, blitted over a cached picture of what never changes.
 
+    Frames are ``FRAME_SIZE`` = 640 x 480 px, ``(480, 640, 3)`` uint8 RGB. The cached
+    picture is made at the first :meth:`frame` (a full draw, ~0.1 s); each frame then
+    costs a few ms. Pickling drops the canvas (it is rebuilt on the next frame).
+
     Parameters
     ----------
     model
         The gait model (object, friction, hand, grid) whose states are drawn.
-
-    Frames are ``FRAME_SIZE`` = 640 x 480 px, ``(480, 640, 3)`` uint8 RGB. The cached
-    picture is made at the first :meth:`frame` (a full draw, ~0.1 s); each frame then
-    costs a few ms. Pickling drops the canvas (it is rebuilt on the next frame).
     """
 
     def __init__(self, model: GaitModel) -> None:
@@ -331,13 +331,13 @@ def can_show() -> bool:
 class GaitRenderer:
     """What a GraspGait env keeps between frames: the human-mode window and the warning.
 
+    Pickling and ``copy.deepcopy`` drop the window (a matplotlib figure does not
+    pickle); the next :meth:`show` opens a new one.
+
     Parameters
     ----------
     render_fps
         Frames per second of human mode (each :meth:`show` pauses ``1 / render_fps`` s).
-
-    Pickling and ``copy.deepcopy`` drop the window (a matplotlib figure does not
-    pickle); the next :meth:`show` opens a new one.
     """
 
     def __init__(self, render_fps: float) -> None:

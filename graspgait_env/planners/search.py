@@ -514,9 +514,9 @@ def best_first(model: GaitModel, start: GaitState | None, turn_deg: float = 360.
     tie_break
         ``"oldest"`` (default): among equal ``M`` the node created first is opened first
         (a queue); ``"newest"``: the node created last (a stack, as a search that pushes
-        children on the head of its queue would). The README's Table 1 shows both beside
-        the thesis's figures.
-    Others
+        children on the head of its queue would). Table 1 of the documentation's
+        science pages shows both beside the thesis's figures.
+    model, start, turn_deg, max_nodes
         As :func:`breadth_first`.
 
     Returns

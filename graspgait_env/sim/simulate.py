@@ -96,6 +96,7 @@ class VideoRecorder:
         self.frames += 1
 
     def close(self) -> None:
+        """Release the off-screen renderer; the caller closes ``writer`` (the video file)."""
         self.view.close()
 
 
@@ -520,7 +521,7 @@ def point_contact_warning(plan: Plan, source: str | os.PathLike = "the plan") ->
     Point-contact grasps may sit at the edge of the friction cone and next to vertices;
     the hand's ball tips roll and carry the rotations' load, and at finger friction = mu
     (the default) they drop such plans (measured: 0 of 24 perturbed runs of the four
-    thesis objects' rule-based and optimal gaits held, README "Running on the hand").
+    thesis objects' rule-based and optimal gaits held; docs/science/hand.md).
     """
     if plan.assumed_contact_model.is_point:
         return (f"{source} was planned for point contacts (no contact_model 'hand'); the "

@@ -263,3 +263,11 @@ def test_object_from_dict_refuses_non_mapping():
 def test_config_error_is_value_error():
     with pytest.raises(ValueError):
         object_from_dict({"name": "x", "type": "circle", "radius": -1})
+
+
+def test_a_folder_of_an_objects_name_does_not_hide_the_bundled_object(tmp_path, monkeypatch):
+    """`graspgait story circle --out circle` then `graspgait simulate circle/...json`: the
+    plan's object "circle" is the bundled one, not the folder beside it."""
+    (tmp_path / "circle").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert load_object("circle").name == "circle"

@@ -1,6 +1,6 @@
 """The controller at the planning friction: rolling ball paths, the friction cone check's
 narrowed cone, the localizer halfway through a grip transfer, and the sim-config
-switches that restore the thesis's controller (README, "Running on the hand")."""
+switches that restore the thesis's controller (docs/science/hand.md)."""
 
 from __future__ import annotations
 
