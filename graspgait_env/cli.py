@@ -1050,6 +1050,19 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
             _write_output("--json", args.json, lambda: write_text_atomic(args.json, text))
             print(f"wrote {args.json}")
         return 0
+    if args.scoreboard:
+        if args.policy is not None:
+            raise GraspGaitInputError(f"POLICY {args.policy!r} with --scoreboard: give one "
+                                      "or the other (--scoreboard reads finished rows)")
+        _check_outputs(args, {"md": (".md",)})
+        _check_outputs(args, {"png": _figure_suffixes()})
+        from graspgait_env.benchmark.scoreboard import scoreboard
+
+        print(scoreboard(args.scoreboard, md=args.md, png=args.png))
+        for flag in ("md", "png"):
+            if getattr(args, flag):
+                print(f"wrote {getattr(args, flag)}")
+        return 0
     if args.policy is None:
         raise GraspGaitInputError("POLICY missing: give random, a planner (e.g. rule), "
                                   "greedy-reach, agent:NAME, a model .zip, config:NAME or bc; "
@@ -1118,7 +1131,9 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                                        "benchmark rule --tasks map-point,random",
                                        "benchmark greedy-reach --json row.json --md row.md",
                                        "benchmark agent:random --tasks random --ray",
-                                       "benchmark config:ellipse --tasks map-hand-ellipse"],
+                                       "benchmark config:ellipse --tasks map-hand-ellipse",
+                                       "benchmark --scoreboard benchmark/rule benchmark/random "
+                                       "--md board.md --png board.png"],
                                       duration="seconds for the example with --episodes 3; "
                                       "7-21 min for a planner or random over the whole suite "
                                       "and 5 seeds (the hand track: 1-10 s per episode); "
@@ -1130,6 +1145,9 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                    "config:NAME or a config .yaml, bc[:optimal|rule]")
     p.add_argument("--list-tasks", action="store_true",
                    help="print the suite (or the tasks of --tasks) and exit")
+    p.add_argument("--scoreboard", nargs="+", metavar="DIR", help="print the scoreboard of "
+                   "finished rows (their --out folders) side by side, with --md and --png "
+                   "its tables and performance profiles, and exit")
     p.add_argument("--tasks", metavar="T,...", help="task ids and track names (map-point, "
                    "map-hand, random, mujoco), comma-separated (default: every task)")
     p.add_argument("--seeds", default="0-4", help="run seeds, e.g. 0-4 or 0,3 (default 0-4)")

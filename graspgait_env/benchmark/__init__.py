@@ -20,7 +20,9 @@ and nothing below imports it.
 - :mod:`~graspgait_env.benchmark.run`: a scoreboard row over tasks x seeds, resumable,
   serially or on Ray (``graspgait benchmark``);
 - :mod:`~graspgait_env.benchmark.datasets`: Minari demonstration datasets
-  (``graspgait dataset record``) and the behaviour-cloning baseline.
+  (``graspgait dataset record``) and the behaviour-cloning baseline;
+- :mod:`~graspgait_env.benchmark.scoreboard`: finished rows side by side, their tables
+  and performance profiles (``graspgait benchmark --scoreboard``).
 
 The protocol, the score's formula, the versioning rule and the scoreboard:
 docs/benchmark.md.
