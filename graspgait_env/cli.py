@@ -1073,6 +1073,8 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     spec = parse_policy(args.policy)
     if spec.kind in ("agent", "agent-template", "config", "bc"):
         _require("train", f"graspgait benchmark {args.policy}")
+    if spec.kind == "rlzoo":
+        _require("zoo", f"graspgait benchmark {args.policy}")
     _require_ray(args, "graspgait benchmark")
     tasks = parse_tasks(args.tasks)
     seeds = parse_seeds(args.seeds)
@@ -1142,7 +1144,8 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                    help="random, a planner name, greedy-reach, agent:NAME or a model .zip "
                    "({task}, {train_task}, {seed} in its path: one model per task and "
                    "seed), "
-                   "config:NAME or a config .yaml, bc[:optimal|rule]")
+                   "config:NAME or a config .yaml, rlzoo:ALGO[:STEPS] (RL Zoo with the bundled "
+                   "hyper-parameters), bc[:optimal|rule]")
     p.add_argument("--list-tasks", action="store_true",
                    help="print the suite (or the tasks of --tasks) and exit")
     p.add_argument("--scoreboard", nargs="+", metavar="DIR", help="print the scoreboard of "

@@ -24,6 +24,12 @@ POLICY is one of:
 - ``config:NAME`` or a training config path (``.yaml``): trained once per task and seed
   (:func:`graspgait_env.agents.train.train`, ``seed`` = the run seed) in the task's
   training env, within the task's step budget, then played greedily;
+- ``rlzoo:ALGO`` or ``rlzoo:ALGO:STEPS``: RL Zoo (``python -m rl_zoo3.train``) with the
+  bundled hyper-parameters ``configs/rlzoo/ALGO.yml`` (``graspgait config rlzoo``), trained
+  once per task and seed (``--seed`` = the run seed, ``--env-kwargs`` = the training
+  task's keywords) for the file's ``n_timesteps`` or ``STEPS``, then played greedily with
+  the wrappers RL Zoo saved (its ``SolvableStartWrapper`` dropped). The bundled files
+  are for ``GraspGait-v0``, so the ``random`` track is refused;
 - ``bc`` or ``bc:POLICY`` (``optimal``, the default, or ``rule``): behaviour cloning,
   trained per task and seed from the task's demonstrations
   (:mod:`graspgait_env.benchmark.datasets`; ``graspgait dataset record`` first).
@@ -52,7 +58,7 @@ from graspgait_env.benchmark.suite import TASK_KEYS, Task, get_task
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["CellPolicy", "PolicySpec", "parse_policy", "prepare_policy", "greedy_reach_predictor",
-           "policy_env_kwargs", "GREEDY_REACH_DEPTH", "START_WRAPPERS"]
+           "policy_env_kwargs", "train_rlzoo", "GREEDY_REACH_DEPTH", "START_WRAPPERS"]
 
 Predict = Callable[[np.ndarray, np.ndarray], int]
 GREEDY_REACH_DEPTH = 3
@@ -64,7 +70,7 @@ DEMO_POLICIES = ("optimal", "rule")
 @dataclass(frozen=True)
 class PolicySpec:
     """A resolved POLICY: ``kind`` (random, planner, greedy-reach, agent, agent-template,
-    config, bc), ``arg`` (the planner, model, model path template, config or
+    config, rlzoo, bc), ``arg`` (the planner, model, model path template, config or
     demonstrating policy) and ``label`` (its name in tables and the default output
     folder)."""
 
@@ -113,6 +119,13 @@ def parse_policy(text: str) -> PolicySpec:
                                       "only {task}, {train_task} and {seed}") from None
         stem = Path(text.format(task="TASK", train_task="TASK", seed="SEED")).stem
         return PolicySpec("agent-template", text, f"agent-{_label(stem)}")
+    if sep and kind == "rlzoo":
+        algo, _, steps = rest.partition(":")
+        _rlzoo_conf(algo)
+        if steps and (not steps.isdigit() or int(steps) < 1):
+            raise GraspGaitInputError(f"POLICY {text!r}: STEPS must be a positive integer, "
+                                      "e.g. rlzoo:ppo:100000")
+        return PolicySpec("rlzoo", rest, f"rlzoo-{_label(rest.replace(':', '-'))}")
     if sep and kind == "config":
         _load_config(rest)
         return PolicySpec("config", rest, f"config-{_label(Path(rest).stem)}")
@@ -129,8 +142,80 @@ def parse_policy(text: str) -> PolicySpec:
     raise GraspGaitInputError(
         f"POLICY {text!r}: not a policy; give random, a planner ({', '.join(PLANNERS)}), "
         "greedy-reach, a shipped agent (agent:NAME, e.g. agent:ellipse) or a model .zip, a "
-        "training config (config:NAME, e.g. config:ellipse, or a .yaml path), or bc[:optimal|"
-        "rule]")
+        "training config (config:NAME, e.g. config:ellipse, or a .yaml path), RL Zoo "
+        "(rlzoo:ppo), or bc[:optimal|rule]")
+
+
+def _rlzoo_conf(algo: str) -> Path:
+    from graspgait_env.resources import bundled_file, bundled_names
+
+    path = bundled_file("rlzoo", algo)
+    if path is None:
+        raise GraspGaitInputError(
+            f"POLICY rlzoo:{algo}: no bundled RL Zoo hyper-parameters {algo!r}; bundled: "
+            f"{', '.join(bundled_names('rlzoo'))} (graspgait config rlzoo)")
+    return path
+
+
+def _rlzoo_conf_steps(conf: Path, env_id: str) -> int:
+    import yaml
+
+    class _Loader(yaml.SafeLoader):  # RL Zoo's files tag floats (!!float 2e5)
+        pass
+
+    hyper = yaml.load(conf.read_text(encoding="utf-8"), Loader=_Loader) or {}
+    if env_id not in hyper:
+        raise GraspGaitInputError(
+            f"POLICY rlzoo: {conf.name} has hyper-parameters for {', '.join(hyper)} only, "
+            f"not {env_id}; give --tasks of those envs (e.g. map-point,map-hand,mujoco)")
+    return int(float(hyper[env_id]["n_timesteps"]))
+
+
+def train_rlzoo(spec: PolicySpec, task: Task, seed: int, workdir: str | Path) -> Path:
+    """Train an ``rlzoo`` POLICY for (task, seed) with ``python -m rl_zoo3.train`` unless
+    its model is already there; the model's path (RL Zoo's log folder is
+    ``workdir/train/TASK/sSEED``, its output in ``rlzoo.log`` there).
+
+    Raises
+    ------
+    GraspGaitInputError
+        The task's training env has no bundled hyper-parameters, or the budget exceeds
+        the task's.
+    """
+    import os
+    import subprocess
+    import sys
+
+    from graspgait_env.atomic import write_text_atomic
+
+    train_task, run_dir = training_plan(spec, task, seed, workdir)
+    algo, _, steps = spec.arg.partition(":")
+    env_id = train_task.train_env_id
+    found = sorted(run_dir.glob(f"{algo}/{env_id}_*/{env_id}.zip"))
+    if found:
+        return found[-1]
+    conf = _rlzoo_conf(algo)
+    n = int(steps) if steps else _rlzoo_conf_steps(conf, env_id)
+    if train_task.train_steps <= 0:
+        raise GraspGaitInputError(f"task {train_task.id}: not a training task")
+    if n > train_task.train_steps:
+        raise GraspGaitInputError(
+            f"POLICY rlzoo:{spec.arg}: {n:,} steps exceed task {train_task.id}'s budget of "
+            f"{train_task.train_steps:,}; give fewer, e.g. rlzoo:{algo}:{train_task.train_steps}")
+    kw = [f"{k}:{v!r}" for k, v in train_task.train_kwargs.items()]
+    cmd = [sys.executable, "-m", "rl_zoo3.train", "--algo", algo, "--env", env_id,
+           "--gym-packages", "graspgait_env", "--conf-file", str(conf), "--seed", str(seed),
+           "-n", str(n), "-f", str(run_dir), "--num-threads", "1", "--eval-freq", "-1",
+           "--log-interval", "-1", *(["--env-kwargs", *kw] if kw else [])]
+    run_dir.mkdir(parents=True, exist_ok=True)
+    done = subprocess.run(cmd, capture_output=True, text=True,
+                          env={**os.environ, "OMP_NUM_THREADS": "1"})
+    write_text_atomic(run_dir / "rlzoo.log", " ".join(cmd) + "\n" + done.stdout + done.stderr)
+    found = sorted(run_dir.glob(f"{algo}/{env_id}_*/{env_id}.zip"))
+    if done.returncode != 0 or not found:
+        raise RuntimeError(f"rl_zoo3.train failed for {train_task.id} seed {seed} (exit "
+                           f"{done.returncode}); its output: {run_dir / 'rlzoo.log'}")
+    return found[-1]
 
 
 def _shipped() -> list[str]:
@@ -351,6 +436,9 @@ def prepare_policy(spec: PolicySpec, task: Task, seed: int, workdir: str | Path,
     if spec.kind == "config":
         model = train_for(spec, task, seed, workdir, progress=progress)
         return _agent_policy(str(model), {"config": spec.arg})
+    if spec.kind == "rlzoo":
+        model = train_rlzoo(spec, task, seed, workdir)
+        return _agent_policy(str(model), {"rlzoo": spec.arg})
     if spec.kind == "bc":
         from graspgait_env.benchmark.datasets import bc_policy_for
 

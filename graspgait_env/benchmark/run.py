@@ -46,6 +46,7 @@ from graspgait_env.benchmark.policies import (
     policy_env_kwargs,
     prepare_policy,
     train_for,
+    train_rlzoo,
     training_plan,
 )
 from graspgait_env.benchmark.score import SCORE_FIELDS, score_records
@@ -184,7 +185,9 @@ def _cell_task(spec: dict, task_id: str, seed: int, episodes: int | None,
 
 
 def _train_task(spec: dict, task_id: str, seed: int, out_dir: str) -> str:
-    return str(train_for(PolicySpec(**spec), get_task(task_id), seed, out_dir))
+    spec = PolicySpec(**spec)
+    train = train_rlzoo if spec.kind == "rlzoo" else train_for
+    return str(train(spec, get_task(task_id), seed, out_dir))
 
 
 class RowResult(dict):
@@ -255,7 +258,7 @@ def run_benchmark(policy: str | PolicySpec, tasks: Sequence[Task], seeds: Sequen
         from graspgait_env.baselines.scale_out import ray_session, run_tasks
 
         with ray_session(ray):
-            if spec.kind == "config":  # train each (training task, seed) once, first
+            if spec.kind in ("config", "rlzoo"):  # train each (training task, seed) once, first
                 jobs = {}
                 for t, s in todo:
                     train_task, _ = training_plan(spec, t, s, out)

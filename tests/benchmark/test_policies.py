@@ -121,3 +121,36 @@ def test_a_model_path_template_names_one_model_per_task_and_seed(tmp_path):
     assert hand["cells"][0]["policy_info"]["model"].endswith("map-hand-circle/s1/model.zip")
     with pytest.raises(GraspGaitInputError, match="only {task}, {train_task} and {seed}"):
         parse_policy("logs/{task}/{run}/model.zip")
+
+
+def test_rlzoo_trains_with_rl_zoo_once_per_training_task_and_seed(tmp_path):
+    """``rlzoo:ppo:STEPS``: ``python -m rl_zoo3.train`` with the bundled hyper-parameters
+    and the training task's keywords; the hand task reuses its map-level twin's model,
+    played with RL Zoo's saved action wrapper and without its start wrapper."""
+    spec = parse_policy("rlzoo:ppo:2048")
+    assert spec.kind == "rlzoo" and spec.label == "rlzoo-ppo-2048"
+    tasks = parse_tasks("map-hand-pentagon,mujoco-pose-pentagon")
+    result = run_benchmark(spec, tasks, [0], out_dir=tmp_path / "row", episodes=1,
+                           progress=False, reps=100)
+    assert not result["failures"]
+    models = sorted((tmp_path / "row" / "train").glob("*/s*/ppo/GraspGait-v0_*/*.zip"))
+    assert [m.relative_to(tmp_path / "row" / "train").parts[:2] for m in models] == [
+        ("map-hand-pentagon", "s0")]
+    log = (models[0].parents[2] / "rlzoo.log").read_text()
+    assert "object:'pentagon'" in log and "contact_model:'hand'" in log and "-n 2048" in log
+    for cell in result["cells"]:
+        assert cell["wrappers"] == ["graspgait_env.agents.wrappers.LegalActionWrapper"]
+        assert cell["policy_info"]["model"] == str(models[0])
+
+
+def test_rlzoo_refuses_what_it_cannot_train(tmp_path):
+    with pytest.raises(GraspGaitInputError, match="no bundled RL Zoo hyper-parameters"):
+        parse_policy("rlzoo:dqn")
+    with pytest.raises(GraspGaitInputError, match="STEPS"):
+        parse_policy("rlzoo:ppo:many")
+    with pytest.raises(GraspGaitInputError, match="GraspGait-v0 only"):
+        run_benchmark("rlzoo:ppo", parse_tasks("random-l0"), [0], out_dir=tmp_path / "r",
+                      episodes=1, progress=False)
+    with pytest.raises(GraspGaitInputError, match="budget"):
+        run_benchmark("rlzoo:ppo:600000", parse_tasks("map-point-circle"), [0],
+                      out_dir=tmp_path / "b", episodes=1, progress=False)
