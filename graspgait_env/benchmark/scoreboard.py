@@ -116,8 +116,8 @@ def scoreboard(folders: Sequence[str | Path], *, md: str | Path | None = None,
     str
         The Markdown tables.
     """
-    from graspgait_env.benchmark.aggregate import plot_profiles, score_matrix
     from graspgait_env.atomic import write_text_atomic
+    from graspgait_env.benchmark.aggregate import plot_profiles, score_matrix
 
     rows = [load_row(f) for f in folders]
     text = scoreboard_markdown(rows)
