@@ -160,10 +160,7 @@ def _rlzoo_conf(algo: str) -> Path:
 def _rlzoo_conf_steps(conf: Path, env_id: str) -> int:
     import yaml
 
-    class _Loader(yaml.SafeLoader):  # RL Zoo's files tag floats (!!float 2e5)
-        pass
-
-    hyper = yaml.load(conf.read_text(encoding="utf-8"), Loader=_Loader) or {}
+    hyper = yaml.safe_load(conf.read_text(encoding="utf-8")) or {}
     if env_id not in hyper:
         raise GraspGaitInputError(
             f"POLICY rlzoo: {conf.name} has hyper-parameters for {', '.join(hyper)} only, "
