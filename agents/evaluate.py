@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import statistics
 import time
@@ -51,7 +50,7 @@ from graspgait_env.agents.envs import contact_model_of, env_kwargs_for, make_env
 from graspgait_env.agents.seeding import seed_everything
 from tqdm.auto import tqdm
 
-from graspgait_env.atomic import write_text_atomic
+from graspgait_env.atomic import json_ready, write_text_atomic
 from graspgait_env.envs.config import check_count, check_mu, check_object
 from graspgait_env.envs.registration import ENV_IDS
 from graspgait_env.errors import GraspGaitInputError
@@ -581,16 +580,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
 
 def write_evaluation(result: Mapping[str, Any], path: str | os.PathLike[str]) -> Path:
     """Write :func:`evaluate`'s result as JSON (atomic; NaN written as null)."""
-    def clean(x: Any) -> Any:
-        if isinstance(x, float) and not math.isfinite(x):
-            return None
-        if isinstance(x, Mapping):
-            return {str(k): clean(v) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [clean(v) for v in x]
-        return x
-
-    return write_text_atomic(path, json.dumps(clean(result), indent=1) + "\n")
+    return write_text_atomic(path, json.dumps(json_ready(result), indent=1) + "\n")
 
 
 def format_evaluation(result: Mapping[str, Any]) -> str:

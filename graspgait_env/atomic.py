@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
-__all__ = ["atomic_write", "write_text_atomic"]
+__all__ = ["atomic_write", "json_ready", "write_text_atomic"]
 
 
 def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], object]) -> Path:
@@ -50,3 +51,17 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], objec
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically (see :func:`atomic_write`)."""
     return atomic_write(path, lambda fh: fh.write(text.encode("utf-8")))
+
+
+def json_ready(x: Any) -> Any:
+    """``x`` with what JSON cannot hold replaced: NaN and infinities by None, NumPy scalars
+    by Python numbers, mapping keys by strings, tuples by lists (recursively)."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, Mapping):
+        return {str(k): json_ready(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_ready(v) for v in x]
+    if hasattr(x, "item") and callable(x.item):  # NumPy scalars
+        return json_ready(x.item())
+    return x

@@ -32,14 +32,13 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 import time
 from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
-from graspgait_env.atomic import write_text_atomic
+from graspgait_env.atomic import json_ready, write_text_atomic
 from graspgait_env.benchmark.policies import (
     PolicySpec,
     parse_policy,
@@ -73,18 +72,6 @@ def cell_path(out_dir: str | Path, task_id: str, seed: int) -> Path:
     return Path(out_dir) / "cells" / task_id / f"s{int(seed)}.json"
 
 
-def _clean(x: Any) -> Any:
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if hasattr(x, "item") and callable(x.item):  # NumPy scalars
-        return _clean(x.item())
-    return x
-
-
 def run_cell(spec: PolicySpec | dict, task_id: str, seed: int, episodes: int | None,
              out_dir: str | Path) -> dict[str, Any]:
     """Play one cell and write it (atomically) to :func:`cell_path`; return it."""
@@ -115,7 +102,7 @@ def run_cell(spec: PolicySpec | dict, task_id: str, seed: int, episodes: int | N
     if task.env_id == "GraspGaitRandom-v0":
         check_disjoint(task, sorted({r["object"] for r in records}))
     own = {k: v for k, v in kwargs.items() if k not in task.kwargs and k != "sim_config"}
-    cell = _clean({
+    cell = json_ready({
         "suite_version": SUITE_VERSION, "policy": spec.label, "spec": spec.to_dict(),
         "task": task.id, "track": task.track, "seed": int(seed), "episodes": n,
         "first_test_seed": first, "env_id": task.env_id,
@@ -296,7 +283,7 @@ def run_benchmark(policy: str | PolicySpec, tasks: Sequence[Task], seeds: Sequen
     files = {"csv": out / "cells.csv", "json": out / "result.json", "md": out / "result.md",
              "png": out / "profile.png"}
     write_csv(result["cells"], files["csv"])
-    write_text_atomic(files["json"], json.dumps(_clean(dict(result)), indent=1) + "\n")
+    write_text_atomic(files["json"], json.dumps(json_ready(dict(result)), indent=1) + "\n")
     write_text_atomic(files["md"], markdown_row(result) + "\n")
     if agg.get("overall"):
         from graspgait_env.benchmark.aggregate import plot_profiles, score_matrix
