@@ -282,13 +282,13 @@ def batched_eval_env(env_id: str, env_kwargs: Mapping[str, Any] | None = None,
                      ) -> Any:
     """The batched env for :func:`run_episodes_batched`, or None where it does not apply.
 
-    It applies to ``GraspGait-v0`` without wrappers, with the config fields that the
-    batched :class:`~graspgait_env.envs.vector_env.GraspGaitVectorEnv` reproduces
-    transition for transition; other ids (``GraspGaitRandom-v0``, ``GraspGaitMujoco-v1``),
-    wrapped envs and fields the batched step does not implement (e.g.
-    ``regrasp_lookahead``; :func:`~graspgait_env.envs.vector_env.unsupported_fields`)
-    return None, and the caller plays the episodes one by one (:func:`run_episodes`), which
-    gives the same records. Bad keywords raise as the single env raises them.
+    It applies to ``GraspGait-v0`` without wrappers: the batched
+    :class:`~graspgait_env.envs.vector_env.GraspGaitVectorEnv` reproduces it transition
+    for transition for every config field (a field it did not implement would be listed
+    by :func:`~graspgait_env.envs.vector_env.unsupported_fields`). Other ids
+    (``GraspGaitRandom-v0``, ``GraspGaitMujoco-v1``) and wrapped envs return None, and
+    the caller plays the episodes one by one (:func:`run_episodes`), which gives the same
+    records. Bad keywords raise as the single env raises them.
     """
     from graspgait_env.envs.vector_env import GraspGaitVectorEnv, unsupported_fields
 

@@ -3,7 +3,7 @@ and a policy that scores every regrasp with one shared network.
 
 :class:`GraspMapExtractor` is an SB3 features extractor (``features_extractor:
 graspgait_env.agents.policies:GraspMapExtractor`` in a training config). It splits the flat
-observation at :class:`graspgait_env.envs.map_env.ObservationLayout`'s slices and reads
+observation at :class:`graspgait_env.envs.observation.ObservationLayout`'s slices and reads
 each part with the structure it has:
 
 - the **header** (held fingers, workspace positions, contact and object angles, turn
@@ -64,8 +64,18 @@ more regrasps after that move stays, a depth-limited search of the grasp map), s
 shared scorer prices every move by what it leads to (:meth:`GraspMapExtractor.
 action_block`).
 Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
-through unchanged too. The features are the concatenation (header and mask, window
-features, line features, tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
+through unchanged too.
+
+**Where the parts lie is the env's.** A training config gives choices and the switches
+of :data:`FEATURE_SWITCHES` (``finishing_rotations``, ``forward_gait``,
+``action_block``), never an offset: the trainer fills in ``cells``, ``line_cells``,
+``tail``, ``turn_steps``, ``rotations``, ``workspace_widths`` and ``reach_depth``
+(:data:`ENV_GEOMETRY`) from the env's
+:class:`~graspgait_env.envs.observation.ObservationLayout` and gait model
+(:func:`extractor_kwargs_for`), and the saved model keeps them.
+
+The features are the concatenation (header and mask, window features, line features,
+tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
 ``MlpPolicy``. The class
 and its keyword arguments are saved in the model zip by SB3 (``policy_kwargs``) and
 rebuilt on load, so a model trained with it loads with :func:`graspgait_env.agents.card.load_agent`
@@ -84,10 +94,11 @@ from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor, MlpExtractor
 from torch import nn
 
-from graspgait_env.envs.map_env import ObservationLayout
+from graspgait_env.envs.observation import ObservationLayout
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["REGRASP_CHANNELS", "GraspMapExtractor", "MaskableRegraspScorerPolicy", "layout_of"]
+__all__ = ["ENV_GEOMETRY", "FEATURE_SWITCHES", "REGRASP_CHANNELS", "GraspMapExtractor",
+           "MaskableRegraspScorerPolicy", "extractor_kwargs_for", "layout_of"]
 
 REGRASP_CHANNELS = 9
 """Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
@@ -126,6 +137,79 @@ def layout_of(observation_space: gym.spaces.Box, cells: int, line_cells: int,
             "map_window_cells and, with map_lines, its grid size n (e.g. cells: 36, "
             "line_cells: 180)")
     return ObservationLayout(n_actions, cells, line_cells)
+
+
+ENV_GEOMETRY: tuple[str, ...] = ("cells", "line_cells", "tail", "turn_steps", "rotations",
+                                 "workspace_widths", "reach_depth")
+""":class:`GraspMapExtractor` keywords that describe the env, not a choice: filled in from
+the env's :class:`~graspgait_env.envs.observation.ObservationLayout` and gait model by
+:func:`extractor_kwargs_for`, so no training config gives them."""
+
+FEATURE_SWITCHES: tuple[str, ...] = ("finishing_rotations", "forward_gait", "action_block")
+"""The training config's switches for the features that need the env's geometry:
+``finishing_rotations`` (``turn_steps`` and ``rotations``), ``forward_gait`` (also
+``workspace_widths``: the forward-gait features, and the regrasp block of
+:class:`MaskableRegraspScorerPolicy`), ``action_block`` (also ``reach_depth``: the env's
+``regrasp_lookahead``)."""
+
+
+def extractor_kwargs_for(env: gym.Env, kwargs: dict[str, Any]) -> dict[str, Any]:
+    """:class:`GraspMapExtractor`'s keyword arguments for ``env`` from a training config's
+    ``features_extractor_kwargs``.
+
+    The config gives choices (``conv``, ``shortfall_bins``, ``best_regrasp``,
+    ``reach_relative``, ``reach_best``, the layer widths) and the switches of
+    :data:`FEATURE_SWITCHES`; where a part of the observation lies and the gait model's
+    sizes (:data:`ENV_GEOMETRY`) come from the env: ``cells`` its map window,
+    ``line_cells`` its map lines' length (0 without ``map_lines``), ``tail`` the entries
+    after them (``rotation_lookahead`` and ``regrasp_lookahead``), ``turn_steps`` the
+    signed turn in grid steps, ``rotations`` ``model.R``, ``workspace_widths``
+    ``model.ws_width``, ``reach_depth`` the reach look-ahead's depth. A geometry keyword
+    the config still gives (an older config) must equal the env's.
+
+    Raises
+    ------
+    GraspGaitInputError
+        A geometry keyword that differs from the env's, a switch that is not True or
+        False, or ``action_block`` on an env without ``regrasp_lookahead``.
+    """
+    u = env.unwrapped
+    lay, model = u.layout, u.model
+    switches = {}
+    for name in FEATURE_SWITCHES:
+        value = kwargs.get(name, False)
+        if not isinstance(value, bool):
+            raise GraspGaitInputError(f"features_extractor_kwargs {name}={value!r}: must be "
+                                      "true or false")
+        switches[name] = value
+    forward = switches["forward_gait"] or switches["action_block"]
+    finishing = switches["finishing_rotations"] or forward
+    if switches["action_block"] and not lay.reach_depth:
+        raise GraspGaitInputError(
+            "features_extractor_kwargs action_block=true: the env has no reach look-ahead; "
+            "set env_kwargs regrasp_lookahead (e.g. 3)")
+    env_values: dict[str, Any] = {
+        "cells": lay.cells, "line_cells": (lay.lines.stop - lay.lines.start) // 2,
+        "tail": lay.size - lay.lines.stop,
+        "turn_steps": int(model.turn_steps(u.config.turn_deg)), "rotations": int(model.R),
+        "workspace_widths": [int(w) for w in model.ws_width], "reach_depth": lay.reach_depth}
+    out = {k: v for k, v in kwargs.items() if k not in FEATURE_SWITCHES}
+    for key, value in env_values.items():
+        if key in out:
+            given = list(out[key]) if key == "workspace_widths" else out[key]
+            if given != value:
+                raise GraspGaitInputError(
+                    f"features_extractor_kwargs {key}={out[key]!r}: this env's is {value!r}; "
+                    "leave it out (it is read from the env's ObservationLayout and gait "
+                    "model)")
+    out.update({k: env_values[k] for k in ("cells", "line_cells", "tail")})
+    if finishing:
+        out.update(turn_steps=env_values["turn_steps"], rotations=env_values["rotations"])
+    if forward:
+        out["workspace_widths"] = env_values["workspace_widths"]
+    if switches["action_block"]:
+        out["reach_depth"] = env_values["reach_depth"]
+    return out
 
 
 def _most_room(room: torch.Tensor) -> torch.Tensor:
@@ -547,8 +631,8 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
 
     ``policy: graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
     ``algo: maskable_ppo`` and ``features_extractor:
-    graspgait_env.agents.policies:GraspMapExtractor``
-    given ``workspace_widths``, ``turn_steps`` and ``rotations``; the policy sets the
+    graspgait_env.agents.policies:GraspMapExtractor`` with ``forward_gait: true``, which
+    gives it ``workspace_widths``, ``turn_steps`` and ``rotations``; the policy sets the
     extractor's ``regrasp_block``).
 
     Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent)
@@ -590,7 +674,7 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
                 "needs graspgait_env.agents.policies:GraspMapExtractor (it computes the regrasp "
                 "block); "
                 "set features_extractor: graspgait_env.agents.policies:GraspMapExtractor with "
-                "workspace_widths, turn_steps and rotations")
+                "features_extractor_kwargs forward_gait: true")
         kwargs["features_extractor_kwargs"] = {**(kwargs.get("features_extractor_kwargs") or {}),
                                                "regrasp_block": True}
         if kwargs.get("share_features_extractor") is False:

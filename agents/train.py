@@ -184,9 +184,18 @@ def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = Non
         "activation_fn": {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config.activation],
     }
     if config.features_extractor is not None:
-        policy_kwargs["features_extractor_class"] = import_object(config.features_extractor,
-                                                                  "features_extractor")
-        policy_kwargs["features_extractor_kwargs"] = dict(config.features_extractor_kwargs)
+        extractor = import_object(config.features_extractor, "features_extractor")
+        policy_kwargs["features_extractor_class"] = extractor
+        kwargs = dict(config.features_extractor_kwargs)
+        from graspgait_env.agents.policies import GraspMapExtractor, extractor_kwargs_for
+
+        if isinstance(extractor, type) and issubclass(extractor, GraspMapExtractor):
+            # the observation's geometry comes from the env (its ObservationLayout),
+            # never from the config
+            probe = make_env(config.env_id, config.env_kwargs)
+            kwargs = extractor_kwargs_for(probe, kwargs)
+            probe.close()
+        policy_kwargs["features_extractor_kwargs"] = kwargs
     lr: Any = config.learning_rate
     if config.lr_schedule == "linear":
         lr0 = config.learning_rate

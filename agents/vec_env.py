@@ -84,7 +84,7 @@ class GraspGaitVecEnv(VecEnv):
         self._reset_seeds()
         self._reset_options()
         self.last_info = info
-        return np.array(obs, copy=True)
+        return _copy(obs)
 
     def step_async(self, actions: np.ndarray) -> None:
         """Store the actions (one per sub-env) for :meth:`step_wait`."""
@@ -100,14 +100,16 @@ class GraspGaitVecEnv(VecEnv):
             idx = np.flatnonzero(done)
             success = info["is_success"]
             for i in idx.tolist():
-                infos[i] = {"terminal_observation": obs[i].copy(),
+                infos[i] = {"terminal_observation": _copy(obs, i),
                             "TimeLimit.truncated": bool(truncated[i] and not terminated[i]),
                             "is_success": bool(success[i])}
-            _, reset_info = self.venv.reset(options={"reset_mask": done})
+            # every row, the restarted ones their next episode's (a fresh dict of parts
+            # with observation_mode "dict"; the same buffer with "box")
+            obs, reset_info = self.venv.reset(options={"reset_mask": done})
             for i in idx.tolist():
                 self.reset_infos[i] = self._info_row(reset_info, i)
         self.last_info = info
-        return obs.copy(), reward.astype(np.float32), done, infos
+        return _copy(obs), reward.astype(np.float32), done, infos
 
     def close(self) -> None:
         """Close the batched env."""
@@ -169,6 +171,14 @@ class GraspGaitVecEnv(VecEnv):
         """Sub-env ``i``'s entries of a batched info dict (where its ``_key`` mask is set)."""
         return {k: v[i] for k, v in info.items()
                 if not k.startswith("_") and not isinstance(v, dict) and info["_" + k][i]}
+
+
+def _copy(obs: Any, row: int | None = None) -> Any:
+    """A copy of a batch of observations (an array, or a dict of parts with
+    ``observation_mode="dict"``), or of its row ``row``."""
+    if isinstance(obs, dict):
+        return {k: _copy(v, row) for k, v in obs.items()}
+    return np.array(obs if row is None else obs[row], copy=True)
 
 
 def make_batched_vec_env(n_envs: int, seed: int | None = None,

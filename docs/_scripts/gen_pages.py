@@ -54,7 +54,7 @@ ARGUMENT_GROUPS: dict[str, tuple[str, ...]] = {
                                        "illegal_penalty", "to_go_weight"),
     "The observation (see *Observation Space*)": ("map_window_deg", "map_window_cells",
                                                   "map_lines", "rotation_lookahead",
-                                                  "regrasp_lookahead"),
+                                                  "regrasp_lookahead", "observation_mode"),
     "Move rules beyond the thesis (see *Action Space*)": ("forbid_reversal",
                                                           "forbid_revisit"),
 }
@@ -144,10 +144,8 @@ def _bounds(env: Any, part: slice | int) -> str:
 
 
 def layout_parts(layout: Any) -> list[str]:
-    """The parts of an :class:`ObservationLayout`, in index order (its slices and
-    indices, in the order it assigns them)."""
-    return [k for k, v in vars(layout).items() if isinstance(v, (slice, int))
-            and k not in ("cells", "size")]
+    """The parts of an :class:`ObservationLayout`'s box vector, in index order."""
+    return list(layout.box_parts)
 
 
 def _code(value: Any) -> str:
@@ -227,6 +225,43 @@ def observation_table(env_id: str, rows: list[list[str]]) -> str:
             f"({base.action_space.n} actions) and `map_window_cells = "
             f"{base.config.map_window_cells}`; an opt-in part is appended after the "
             "grasp-map window, in the order of the table.\n\n" + table)
+
+
+def _space_bounds(space: Any) -> str:
+    return f"[{float(space.low.min()):.4g}, {float(space.high.max()):.4g}]"
+
+
+def named_parts_table(env_id: str) -> str:
+    """The named parts of ``observation_mode="dict"`` (and their place in the
+    ``"flat"`` vector) with the defaults and with every opt-in field, then the columns
+    of the ``actions`` part, all from the env's ``ObservationLayout``."""
+    from graspgait_env.envs.observation import ACTION_FEATURES
+
+    cls = _env_class(env_id)
+    base = _make(cls, observation_mode="dict")
+    every = _make(cls, observation_mode="dict", **{f: v for f, v in OPT_IN_PARTS.values()})
+    rows = []
+    for name, (sl, shape) in every.layout.parts.items():
+        own = base.layout.parts.get(name)
+        rows.append([f"`{name}`",
+                     f"`{own[1]}`, {_span(own[0])}" if own else "-",
+                     f"`{shape}`, {_span(sl)}",
+                     _space_bounds(base.observation_space[name]) if own
+                     else _space_bounds(every.observation_space[name])])
+    table = _table(["Part", "Shape, flat index (defaults)",
+                    "Shape, flat index (every opt-in field)", "Bounds"], rows)
+    extra = [c for c in every.layout.action_features if c not in ACTION_FEATURES]
+    return ("With `observation_mode=\"dict\"` the observation is a `Dict` of these parts "
+            "(`env.layout.parts`); with `observation_mode=\"flat\"` it is that dict "
+            f"flattened, {base.layout.flat_size} entries with the defaults and "
+            f"{every.layout.flat_size} with every opt-in field, each part at the flat "
+            "index given:\n\n" + table + "\n\nThe columns of `actions` "
+            "(`env.layout.action_features`, thesis 5.2 for rotations and 4.2 for "
+            "regrasps; [`graspgait_env.envs.observation`][graspgait_env.envs.observation] "
+            "defines each): "
+            + ", ".join(f"`{c}`" for c in ACTION_FEATURES)
+            + ", then, where those fields are on, " + ", ".join(f"`{c}`" for c in extra)
+            + " (`rotation_lookahead`, `regrasp_lookahead = 3`).")
 
 
 def rewards_table(env_id: str, rows: list[list[str]]) -> str:
@@ -362,11 +397,13 @@ def _table_source(cls: type, title: str) -> list[list[str]]:
 
 def _observation_section(env_id: str, body: str, owner: type, cls: type) -> str:
     before, rows, after = _split_table(_md(body, owner))
+    named = "**Named parts.** " + named_parts_table(env_id)
     if not rows:  # the section refers to GraspGait-v0's: the table comes from there
         rows = _table_source(cls, "Observation Space")
-        return before.rstrip() + "\n\n" + observation_table(env_id, rows)
+        return (before.rstrip() + "\n\n" + observation_table(env_id, rows) + "\n\n"
+                + named)
     return (before.rstrip() + "\n\n" + observation_table(env_id, rows) + "\n\n"
-            + after.strip())
+            + after.strip() + "\n\n" + named)
 
 
 def _rewards_section(env_id: str, body: str, owner: type, cls: type) -> str:

@@ -276,6 +276,15 @@ class GraspGaitConfig:
     (every move leads to a visited state). False (the default): the moves of
     ``model.action_mask``."""
 
+    observation_mode: str = "box"
+    """What ``reset`` and ``step`` return (:mod:`graspgait_env.envs.observation`):
+    ``"box"`` (the default), one vector read by the offsets of the env's *Observation
+    Space* table (what the shipped models read); ``"dict"``, a ``Dict`` of named parts
+    (``grasp``, ``actions`` with one row of features per action, ``window``, and
+    ``lines`` with ``map_lines``); ``"flat"``, that dict flattened into one ``Box``
+    (``gymnasium.spaces.flatten`` of it). The moves, masks and rewards are the same in
+    every mode."""
+
     def __post_init__(self) -> None:
         def put(name: str, value: Any) -> None:
             object.__setattr__(self, name, value)  # frozen: normalize once, here
@@ -331,6 +340,9 @@ class GraspGaitConfig:
             raise GraspGaitInputError(
                 f"forbid_revisit={self.forbid_revisit!r}: must be True or False")
         put("forbid_revisit", bool(self.forbid_revisit))
+        from graspgait_env.envs.observation import check_observation_mode
+
+        check_observation_mode(self.observation_mode)
         from graspgait_env.contact_model import CONTACT_MODELS
 
         if self.contact_model not in CONTACT_MODELS:

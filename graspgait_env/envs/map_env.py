@@ -29,6 +29,16 @@ from graspgait_env.envs.config import (
     check_seed,
     env_id_of,
 )
+from graspgait_env.envs.observation import (
+    _ACHIEVED,
+    _HELD,
+    _PHI,
+    _POS,
+    _THETA,
+    _TO_GO,
+    ObservationLayout,
+    ObservationParts,
+)
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import REGRASP, ROTATE, GaitModel, GaitState
 from graspgait_env.planners.exact import RegraspsToGo
@@ -38,7 +48,6 @@ from graspgait_env.workspace import Hand
 
 __all__ = [
     "GraspGaitEnv",
-    "ObservationLayout",
     "REWARD_TERMS",
     "ResetNeededError",
     "Visits",
@@ -52,51 +61,7 @@ __all__ = [
 # Reward terms, in the fixed order in which the reward is summed.
 REWARD_TERMS: tuple[str, ...] = ("turn", "regrasp", "rotation", "success", "dead_end", "illegal")
 
-# Observation header (see the class docstring's table).
-_HELD = 0  # 3 entries
-_POS = 3  # 3 entries
-_PHI = 6  # 6 entries: (cos, sin) per finger
-_THETA = 12  # 2 entries: cos, sin
-_ACHIEVED = 14
-_TO_GO = 15
-_HEADER = 16
 _START_TRIES = 64  # random start draws before scanning all starts for one with a legal move
-
-
-class ObservationLayout:
-    """Where each part of the flat observation lives (slices into the vector).
-
-    Attributes
-    ----------
-    held, position, contact_cos_sin, theta_cos_sin, achieved, to_go, mask, window, lines,
-    lookahead, reach
-        Slices (``achieved`` and ``to_go`` are indices); ``window`` reshapes to
-        ``(cells, cells)``, ``lines`` (``map_lines``; else empty) to ``(2, n)``;
-        ``lookahead`` (``rotation_lookahead``; else empty) has one entry per rotation
-        action, ``2 R``; ``reach`` (``regrasp_lookahead = D``; else empty) holds ``2 P x
-        D`` entries (per regrasp action, row-major), then ``2 R x D`` (per rotation).
-    size
-        Length of the observation vector.
-    """
-
-    def __init__(self, n_actions: int, cells: int, line_cells: int = 0,
-                 lookahead: int = 0, reach: int = 0) -> None:
-        self.held = slice(_HELD, _HELD + 3)
-        self.position = slice(_POS, _POS + 3)
-        self.contact_cos_sin = slice(_PHI, _PHI + 6)
-        self.theta_cos_sin = slice(_THETA, _THETA + 2)
-        self.achieved = _ACHIEVED
-        self.to_go = _TO_GO
-        self.mask = slice(_HEADER, _HEADER + n_actions)
-        self.window = slice(_HEADER + n_actions, _HEADER + n_actions + cells * cells)
-        end = self.window.stop
-        self.lines = slice(end, end + 2 * line_cells)  # empty unless map_lines
-        end = self.lines.stop
-        self.lookahead = slice(end, end + lookahead)  # empty unless rotation_lookahead
-        end = self.lookahead.stop
-        self.reach = slice(end, end + reach)  # empty unless regrasp_lookahead
-        self.cells = cells
-        self.size = end + reach
 
 
 class ResetNeededError(gym.error.ResetNeeded, RuntimeError):
@@ -219,7 +184,11 @@ def state_from_observation(obs: NDArray[np.floating], model: GaitModel,
 
     Uses the held one-hot, the workspace positions and the turn achieved, all of which
     encode integers exactly in float32. ``model`` and ``turn_deg`` must be the env's.
+    Any ``observation_mode``: a box or flat vector (both begin with the 16 entries of
+    the grasp part) or a dict (its ``grasp`` part).
     """
+    if isinstance(obs, Mapping):
+        obs = obs["grasp"]
     K = model.turn_steps(turn_deg)
     k = int(round(float(obs[_ACHIEVED]) * abs(K))) * (1 if K >= 0 else -1)
     cs = [-1, -1, -1]
@@ -371,6 +340,18 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     With the held fingers, positions and turn achieved the observation determines the
     state exactly: :func:`state_from_observation`.
 
+    **Named parts** (``observation_mode``; :mod:`graspgait_env.envs.observation`). The
+    table above is the ``"box"`` observation, the default. ``observation_mode="dict"``
+    returns a ``Dict`` of named parts instead: ``grasp`` (entries 0 .. 15 above),
+    ``actions`` (``A x F``: per action, whether it is legal and what it leads to, the
+    turn achieved and the rotation room towards and against the goal after it, and the
+    look-ahead fields' entries of that action where they are on), ``window`` (``C x
+    C``) and, with ``map_lines``, ``lines`` (``2 x n``). ``observation_mode="flat"``
+    returns that dict flattened into one ``Box`` (``gymnasium.spaces.flatten``), for
+    ``MlpPolicy``. ``env.layout.parts`` gives each part's place in the flat vector and
+    ``env.layout.action_features`` the columns of ``actions``. The moves, masks and
+    rewards are the same in every mode.
+
     ## Rewards
 
     The thesis's path metric ``M = αθ - βη - γr`` (5.4: θ the object angle, η regrasps,
@@ -491,7 +472,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
     - v0: initial version. Opt-in fields added since, each off by default (tested), so
       the defaults behave as before: ``to_go_weight``, ``map_lines``,
       ``contact_model``, ``rotation_lookahead``, ``forbid_reversal``,
-      ``forbid_revisit``.
+      ``forbid_revisit``, ``regrasp_lookahead``, and ``observation_mode`` (named parts;
+      the default ``"box"`` is the observation as before).
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"],
@@ -613,8 +595,15 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         lo[_ACHIEVED], hi[_ACHIEVED] = -(B + R) / K, (K + R) / K
         lo[_TO_GO], hi[_TO_GO] = 0.0, (K + B + R) / K
         hi[self.layout.reach] = (K + B + 1) / K  # the reach look-ahead's "none" (below)
-        self.observation_space = spaces.Box(lo.astype(np.float32), hi.astype(np.float32),
-                                            dtype=np.float32)
+        self.box_space = spaces.Box(lo.astype(np.float32), hi.astype(np.float32),
+                                    dtype=np.float32)
+        mode = self.config.observation_mode
+        # observation_mode "dict" / "flat": the named parts, from the box vector
+        self._parts = (None if mode == "box" else ObservationParts(
+            self.layout, self.box_space, np.asarray(self.model.ws_width), self._rot_delta,
+            self._sign, self._Kabs, mode))
+        self.observation_space = (self.box_space if self._parts is None
+                                  else self._parts.space)
         self.action_space = spaces.Discrete(A)
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
         self._win_view = self._obs[self.layout.window].reshape(C, C)
@@ -728,6 +717,21 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         if self._reach is not None:
             self._reach_view[...] = self._reach.move_shortfalls(
                 self._h, f, g, self._p[f], self._p[g], k, self._mask, self._rot_delta)
+
+    def _observe(self) -> Any:
+        """The observation of the present state in the config's ``observation_mode``: a
+        copy of the box vector, or its named parts (:class:`ObservationParts`, a batch
+        of one)."""
+        if self._parts is None:
+            return self._obs.copy()
+        def one(x: int) -> NDArray[np.int64]:
+            return np.array([x], dtype=np.int64)
+
+        out = self._parts.observe(self._obs[None], one(self._k), one(self._f), one(self._g),
+                                  one(self._h), one(self._p[self._f]), one(self._p[self._g]))
+        if isinstance(out, dict):
+            return {name: v[0] for name, v in out.items()}
+        return out[0]
 
     # ------------------------------------------------------------------ reward
     def _reward(self, k0: int, k1: int, move: str | None, ends: bool,
@@ -862,7 +866,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 "regrasps": 0, "object": self.model.shape.name, "mu": self.model.mu}
         if self.render_mode == "human":
             self.render()
-        return self._obs.copy(), info
+        return self._observe(), info
 
     def _action_index(self, action: Any) -> int:
         """``action`` as an index into the action space (see *Action Space*), or raise."""
@@ -951,7 +955,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         }
         if self.render_mode == "human":
             self.render()
-        return self._obs.copy(), reward, terminated, False, info
+        return self._observe(), reward, terminated, False, info
 
     # ------------------------------------------------------------------ rendering
     def render(self) -> NDArray[np.uint8] | None:

@@ -173,6 +173,8 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
       the sim's finger friction equals ``mu`` (was 1.0), the controller's check cone is
       narrowed by the hand's margin and the fingers follow their rolling balls; renders
       the hand from a camera above with overlays (was the map-level picture).
+      ``observation_mode`` (named parts) added since, opt-in: the default ``"box"`` is
+      the observation as before.
     - v0: initial version.
     """
 
@@ -323,7 +325,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
         info.update(self._sim_info(report, None))
         if self.render_mode == "human":
             self.render()
-        return self._obs.copy(), info
+        return self._observe(), info
 
     def _sim_info(self, report: StepReport | None, warning: str | None) -> dict[str, Any]:
         ex = self.executor
@@ -386,7 +388,7 @@ class GraspGaitMujocoEnv(GraspGaitEnv):
             info["dropped"] = True
         if self.render_mode == "human":
             self.render()
-        return self._obs.copy(), reward, True, False, info
+        return self._observe(), reward, True, False, info
 
     # ------------------------------------------------------------------ rendering
     def render(self) -> NDArray[np.uint8] | None:

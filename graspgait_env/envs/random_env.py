@@ -95,7 +95,8 @@ class GraspGaitRandomEnv(GraspGaitEnv):
 
     ## Version History
 
-    - v0: initial version.
+    - v0: initial version. ``observation_mode`` (named parts) added since, opt-in: the
+      default ``"box"`` is the observation as before.
     """
 
     _RESET_OPTIONS: ClassVar[tuple[str, ...]] = ("start", "object", "object_seed", "mu")

@@ -24,12 +24,6 @@ from numpy.typing import NDArray
 
 from graspgait_env.envs.config import GraspGaitConfig, check_count
 from graspgait_env.envs.map_env import (
-    _HEADER,
-    _HELD,
-    _PHI,
-    _POS,
-    _THETA,
-    _TO_GO,
     REWARD_TERMS,
     GraspGaitEnv,
     ResetNeededError,
@@ -39,6 +33,7 @@ from graspgait_env.envs.map_env import (
     new_visits,
     visit_state,
 )
+from graspgait_env.envs.observation import _HEADER, _HELD, _PHI, _POS, _THETA, _TO_GO
 from graspgait_env.envs.registration import MAX_EPISODE_STEPS
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.shapes import Shape
@@ -54,7 +49,7 @@ SUPPORTED_FIELDS: frozenset[str] = frozenset({
     "hand", "turn_deg", "n", "alpha", "beta", "gamma", "turn_scale_deg", "success_bonus",
     "dead_end_penalty", "illegal_penalty", "to_go_weight", "max_backward_deg",
     "map_window_deg", "map_window_cells", "map_lines", "contact_model", "rotation_lookahead",
-    "regrasp_lookahead", "forbid_reversal", "forbid_revisit",
+    "regrasp_lookahead", "forbid_reversal", "forbid_revisit", "observation_mode",
 })
 
 
@@ -199,6 +194,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self.config = env.config
         self.model = env.model
         self.layout = env.layout
+        self._parts = env._parts  # observation_mode "dict" / "flat" (None: "box")
         self.num_envs = N
         self.max_episode_steps = max_episode_steps
         self.render_mode = None
@@ -386,10 +382,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         """Reset sub-envs ``idx`` with the single env's ``reset`` and load their states."""
         for i, seed in zip(idx, seeds, strict=True):
             sub = self._subs[i]
-            obs, info = sub.reset(seed=seed, options=options)
+            _, info = sub.reset(seed=seed, options=options)
             s = sub.state
-            self._obs[i] = obs
-            self._head[i] = obs[:_HEADER]
+            self._obs[i] = sub._obs  # the box vector (any observation_mode)
+            self._head[i] = sub._obs[:_HEADER]
             self._mask[i] = info["action_mask"]
             self._k[i] = s.k
             self._c[i] = s.contacts
@@ -503,6 +499,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         o = self._obs
         o[:, :_HEADER] = self._head
         o[:, self.layout.mask] = self._mask
+        if self._parts is not None:  # observation_mode "dict" / "flat": fresh arrays
+            arN, f, g, p = self._arN, self._f, self._g, self._p
+            return self._parts.observe(o, self._k, f, g, self._h, p[arN, f], p[arN, g])
         # one contiguous copy is cheaper than assembling a fresh array part by part
         return o.copy() if self.copy else o
 

@@ -95,17 +95,27 @@ def test_torch_threads_follow_the_machine():
 def test_each_shipped_model_card_holds_its_bundled_config(name):
     """`graspgait train NAME` trains the shipped model's config: the bundled YAML and the
     config in `agents/models/NAME.json` make the same TrainConfig (a field added after
-    a card was written takes its default)."""
+    a card was written takes its default), but for the extractor's keywords, where the
+    YAML gives switches and the trainer the env's geometry: those must come to the
+    card's."""
+    import dataclasses
     import json
 
     from graspgait_env.agents.bench import shipped_models_dir
+    from graspgait_env.agents.envs import make_env
+    from graspgait_env.agents.policies import extractor_kwargs_for
 
     card = shipped_models_dir() / f"{name}.json"
     assert card.is_file(), f"the shipped card {card} is missing from this install"
     shipped = json.loads(card.read_text(encoding="utf-8"))
     # run_root is where the run was written, not how it was trained
-    assert load_train_config(name, [f"run_root={shipped['config']['run_root']}"]) \
-        == TrainConfig(**shipped["config"])
+    bundled = load_train_config(name, [f"run_root={shipped['config']['run_root']}"])
+    trained = TrainConfig(**shipped["config"])
+    kw = bundled.features_extractor_kwargs
+    if bundled.features_extractor is not None:
+        kw = extractor_kwargs_for(make_env(bundled.env_id, bundled.env_kwargs), kw)
+    assert kw == trained.features_extractor_kwargs
+    assert dataclasses.replace(bundled, features_extractor_kwargs=kw) == trained
     assert shipped["env_kwargs"] == shipped["config"]["env_kwargs"]
 
 

@@ -203,3 +203,54 @@ def test_forward_gait_features_need_the_hand_widths():
                           workspace_widths=[46, 46])
     with pytest.raises(GraspGaitInputError, match="workspace_widths"):
         GraspMapExtractor(env.observation_space, workspace_widths=[46, 46, 46])
+
+
+# the geometry the bundled configs gave by hand until the trainer read it from the env
+# (their shipped models were trained with these; agents/models/*.md)
+_HAND_WRITTEN = {
+    "ellipse": {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
+                "rotations": 45},
+    "hexagon": {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
+                "rotations": 45, "workspace_widths": [46, 46, 46]},
+    "random": {"cells": 1, "line_cells": 0, "conv": False, "tail": 546, "turn_steps": 180,
+               "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 3,
+               "reach_relative": True, "reach_best": True},
+}
+
+
+@pytest.mark.parametrize("name", sorted(_HAND_WRITTEN))
+def test_the_env_gives_the_geometry_the_configs_gave_by_hand(name):
+    from graspgait_env.agents.envs import make_env
+    from graspgait_env.agents.policies import ENV_GEOMETRY, extractor_kwargs_for
+
+    cfg = load_train_config(name)
+    assert not set(cfg.features_extractor_kwargs) & set(ENV_GEOMETRY), (
+        f"configs/train/{name}.yaml gives an observation offset")
+    env = make_env(cfg.env_id, cfg.env_kwargs)
+    assert extractor_kwargs_for(env, cfg.features_extractor_kwargs) == _HAND_WRITTEN[name]
+
+
+def test_no_bundled_config_gives_an_observation_offset():
+    from graspgait_env.agents.policies import ENV_GEOMETRY
+
+    from graspgait_env.resources import bundled_names
+
+    for name in bundled_names("train"):
+        kw = load_train_config(name).features_extractor_kwargs
+        assert not set(kw) & set(ENV_GEOMETRY), (name, kw)
+
+
+def test_the_geometry_follows_the_env_and_a_wrong_one_is_refused():
+    from graspgait_env.agents.policies import extractor_kwargs_for
+
+    env = _env(turn_deg=-90.0, map_lines=True, regrasp_lookahead=2, map_window_cells=9)
+    kw = extractor_kwargs_for(env, {"forward_gait": True, "action_block": True})
+    assert kw == {"cells": 9, "line_cells": 180, "tail": 182 * 2, "turn_steps": -45,
+                  "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 2}
+    with pytest.raises(GraspGaitInputError, match=r"tail=90: this env's is 364.*leave it out"):
+        extractor_kwargs_for(env, {"tail": 90})
+    assert extractor_kwargs_for(env, {"tail": 364})["tail"] == 364  # an older config
+    with pytest.raises(GraspGaitInputError, match="action_block=true.*regrasp_lookahead"):
+        extractor_kwargs_for(_env(), {"action_block": True})
+    with pytest.raises(GraspGaitInputError, match="forward_gait='yes'"):
+        extractor_kwargs_for(_env(), {"forward_gait": "yes"})

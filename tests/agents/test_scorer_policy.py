@@ -21,8 +21,7 @@ from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 _SCORER = [
     "policy=graspgait_env.agents.policies:MaskableRegraspScorerPolicy",
     "features_extractor=graspgait_env.agents.policies:GraspMapExtractor",
-    "features_extractor_kwargs={cells: 36, conv: false, turn_steps: 180, rotations: 45, "
-    "workspace_widths: [46, 46, 46]}",
+    "features_extractor_kwargs={conv: false, forward_gait: true}",
 ]
 
 

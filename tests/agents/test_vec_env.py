@@ -15,17 +15,27 @@ def _legal(masks: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return np.array([rng.choice(np.flatnonzero(m)) for m in masks])
 
 
-@pytest.mark.parametrize("n_envs", [1, 5])
-def test_same_transitions_as_dummy_vec_env(n_envs):
+def _assert_equal(x, y) -> None:
+    """Equal arrays, or equal dicts of arrays (observation_mode "dict")."""
+    if isinstance(x, dict):
+        assert isinstance(y, dict) and list(x) == list(y)
+        for key in x:
+            np.testing.assert_array_equal(x[key], y[key])
+    else:
+        np.testing.assert_array_equal(x, y)
+
+
+@pytest.mark.parametrize(("n_envs", "mode"), [(1, "box"), (5, "box"), (5, "dict")])
+def test_same_transitions_as_dummy_vec_env(n_envs, mode):
     """SB3's autoreset, terminal observations, time-limit flags and float32 rewards, as
     DummyVecEnv over gymnasium.make gives them (short turns: many episode ends)."""
     from stable_baselines3.common.env_util import make_vec_env
 
-    kw = {"turn_deg": 20.0, "max_backward_deg": 10.0}
+    kw = {"turn_deg": 20.0, "max_backward_deg": 10.0, "observation_mode": mode}
     a = make_batched_vec_env(n_envs, seed=3, env_kwargs=kw, max_episode_steps=60)
     b = make_vec_env(lambda: gym.make("GraspGait-v0", max_episode_steps=60, **kw),
                      n_envs=n_envs, seed=3)
-    np.testing.assert_array_equal(a.reset(), b.reset())
+    _assert_equal(a.reset(), b.reset())
     rng = np.random.default_rng(0)
     ends = 0
     for _ in range(300):
@@ -33,7 +43,7 @@ def test_same_transitions_as_dummy_vec_env(n_envs):
         np.testing.assert_array_equal(masks, np.stack(b.env_method("action_masks")))
         act = _legal(masks, rng)
         (oa, ra, da, ia), (ob, rb, db, ib) = a.step(act), b.step(act)
-        np.testing.assert_array_equal(oa, ob)
+        _assert_equal(oa, ob)
         assert ra.dtype == rb.dtype == np.float32
         np.testing.assert_array_equal(ra, rb)
         np.testing.assert_array_equal(da, db)
@@ -42,7 +52,7 @@ def test_same_transitions_as_dummy_vec_env(n_envs):
                 assert x == {}
                 continue
             ends += 1
-            np.testing.assert_array_equal(x["terminal_observation"], y["terminal_observation"])
+            _assert_equal(x["terminal_observation"], y["terminal_observation"])
             assert x["TimeLimit.truncated"] == y["TimeLimit.truncated"]
             assert x["is_success"] == y["is_success"]
             assert x["episode"]["l"] == y["episode"]["l"]
@@ -66,6 +76,21 @@ def test_maskable_ppo_trains_on_it():
     masks = get_action_masks(env)
     actions, _ = model.predict(obs, action_masks=masks, deterministic=True)
     assert masks[np.arange(4), actions].all()
+
+
+def test_maskable_ppo_trains_on_named_parts():
+    """observation_mode="dict" with sb3-contrib's MultiInputPolicy."""
+    import torch
+    from sb3_contrib import MaskablePPO
+
+    torch.set_num_threads(1)
+    env = make_batched_vec_env(4, seed=0, env_kwargs={"observation_mode": "dict"})
+    model = MaskablePPO("MultiInputPolicy", env, n_steps=16, batch_size=32, n_epochs=1,
+                        policy_kwargs={"net_arch": [16]}, seed=0)
+    model.learn(64)
+    assert model.num_timesteps == 64
+    obs = env.reset()
+    assert set(obs) == {"grasp", "actions", "window"} and obs["actions"].shape[0] == 4
 
 
 def test_attributes_and_refusals():

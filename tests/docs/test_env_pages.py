@@ -99,12 +99,14 @@ def test_rewards_give_every_term_with_its_default_weight(pages: dict[str, str],
 def test_observation_table_gives_every_part_with_its_indices(gen, pages: dict[str, str],
                                                              env_id: str) -> None:
     section = _section(pages[env_id], "Observation Space")
-    rows = _rows(section)
+    box, _, named = section.partition("**Named parts.**")
+    rows = _rows(box)
     env = gym.make(env_id).unwrapped
     assert f"Length **{env.observation_space.shape[0]}** with the defaults" in section
     every = gym.make(env_id, **{f: v for f, v in gen.OPT_IN_PARTS.values()}).unwrapped
-    parts = [k for k, v in vars(env.layout).items()
-             if isinstance(v, (slice, int)) and k not in ("cells", "size")]
+    parts = list(env.layout.box_parts)
+    # every slice of the layout is a part, and the parts tile the vector in order
+    assert {k for k, v in vars(env.layout).items() if isinstance(v, slice)} <= set(parts)
     assert parts == list(rows), (parts, list(rows))
     for part in parts:
         default = _span(getattr(env.layout, part))
@@ -117,6 +119,28 @@ def test_observation_table_gives_every_part_with_its_indices(gen, pages: dict[st
             assert rows[part][1] == default, (env_id, part)
         assert rows[part][3] == _span(getattr(every.layout, part)), (env_id, part)
         assert rows[part][6], f"{env_id}: part {part} has no description"
+
+
+@pytest.mark.parametrize("env_id", list(ENV_IDS))
+def test_named_parts_table_gives_each_part_its_shape_and_flat_index(
+        gen, pages: dict[str, str], env_id: str) -> None:
+    section = _section(pages[env_id], "Observation Space")
+    named = section.partition("**Named parts.**")[2]
+    rows = _rows(named)
+    env = gym.make(env_id, observation_mode="dict").unwrapped
+    every = gym.make(env_id, observation_mode="dict",
+                     **{f: v for f, v in gen.OPT_IN_PARTS.values()}).unwrapped
+    assert list(rows) == list(every.observation_space)
+    for name, (sl, shape) in every.layout.parts.items():
+        assert every.observation_space[name].shape == shape
+        assert rows[name][2] == f"`{shape}`, {_span(sl)}", (env_id, name)
+        if name in env.layout.parts:
+            own_sl, own_shape = env.layout.parts[name]
+            assert env.observation_space[name].shape == own_shape
+            assert rows[name][1] == f"`{own_shape}`, {_span(own_sl)}", (env_id, name)
+    assert f"flattened, {env.layout.flat_size} entries with the defaults" in named
+    for feature in every.layout.action_features:
+        assert f"`{feature}`" in named
 
 
 def test_the_pages_generate_without_warnings(gen, caplog: pytest.LogCaptureFixture) -> None:

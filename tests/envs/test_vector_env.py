@@ -102,7 +102,7 @@ def test_same_transitions_at_the_registered_time_limit():
     assert ends["truncated"] >= 2
 
 
-@pytest.mark.parametrize("kw", [
+CONFIG_CASES = [
     {"object": "pentagon", "mu": 0.5, "turn_deg": -60.0, "max_episode_steps": 40},
     {"beta": 0.2, "gamma": 0.0, "alpha": -1.0, "turn_scale_deg": 45.0, "success_bonus": 3.0,
      "illegal_penalty": 0.5, "map_window_cells": 9, "map_window_deg": 90.0, "turn_deg": 30.0},
@@ -123,9 +123,33 @@ def test_same_transitions_at_the_registered_time_limit():
     {"regrasp_lookahead": 1, "contact_model": "hand", "object": "hexagon", "turn_deg": -40.0},
     {"regrasp_lookahead": 2, "forbid_revisit": True, "forbid_reversal": True,
      "rotation_lookahead": True, "map_lines": True, "n": 90, "turn_deg": 90.0},
-])
+    {"observation_mode": "dict", "dead_end_penalty": 2.0, "max_backward_deg": 20.0,
+     "turn_deg": 60.0},
+    {"observation_mode": "dict", "regrasp_lookahead": 1, "contact_model": "hand",
+     "object": "hexagon", "turn_deg": -40.0, "forbid_reversal": True},
+    {"observation_mode": "flat", "regrasp_lookahead": 2, "rotation_lookahead": True,
+     "map_lines": True, "n": 90, "turn_deg": 40.0},
+]
+
+
+@pytest.mark.parametrize("kw", CONFIG_CASES)
 def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
+
+
+def test_the_config_cases_set_every_field_off_its_default():
+    """The equality test above covers every config field, each away from its default in
+    at least one case (a field added to the config needs a case here)."""
+    from dataclasses import fields
+
+    from graspgait_env.envs.config import GraspGaitConfig
+
+    default = GraspGaitConfig()
+    covered = {name for kw in CONFIG_CASES for name, value in kw.items()
+               if name in GraspGaitConfig.field_names()
+               and (name == "hand" or value != getattr(default, name))}
+    missing = [f.name for f in fields(GraspGaitConfig) if f.name not in covered]
+    assert not missing, f"no case of CONFIG_CASES sets {missing} off its default"
 
 
 def test_reset_mask_and_start_option_match_sync():
