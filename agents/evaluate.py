@@ -43,6 +43,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from graspgait_env.agents.audit import audit_moves, summarize_audits
 from graspgait_env.agents.card import load_agent
@@ -277,6 +278,21 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
     return out
 
 
+def _take_rows(obs: Any, rows: Any) -> Any:
+    """Rows ``rows`` of a batch of observations: an array, or a dict of parts
+    (``observation_mode="dict"``)."""
+    if isinstance(obs, dict):
+        return {k: v[rows] for k, v in obs.items()}
+    return obs[rows]
+
+
+def _shapes(space: Any) -> Any:
+    """An observation space's shape, or its parts' shapes (a ``Dict`` space)."""
+    if isinstance(space, gym.spaces.Dict):
+        return {k: v.shape for k, v in space.spaces.items()}
+    return space.shape
+
+
 def batched_eval_env(env_id: str, env_kwargs: Mapping[str, Any] | None = None,
                      wrappers: tuple[str, ...] | list[str] = (), num_envs: int = EVAL_BATCH
                      ) -> Any:
@@ -350,7 +366,8 @@ def run_episodes_batched(predict_batch: Callable[[np.ndarray, np.ndarray], np.nd
         while running.any():
             rows = running.nonzero()[0]
             masks = venv.action_masks()
-            a = np.asarray(predict_batch(obs[rows], masks[rows]), dtype=np.int64).reshape(-1)
+            a = np.asarray(predict_batch(_take_rows(obs, rows), masks[rows]),
+                           dtype=np.int64).reshape(-1)
             actions[:] = 0
             actions[rows] = a
             inside = (a >= 0) & (a < masks.shape[1])
@@ -534,11 +551,12 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
     kwargs.update(env_overrides or {})
     env = make_env(env_id, kwargs, card.get("wrappers") or ())
     try:
-        if env.observation_space.shape != model.observation_space.shape:
+        if _shapes(env.observation_space) != _shapes(model.observation_space):
             raise GraspGaitInputError(
-                f"model {str(model_path)!r}: observes {model.observation_space.shape}, the "
-                f"env {env_id} gives {env.observation_space.shape}; evaluate with the env "
-                "settings the model was trained with (hand, n, map window)")
+                f"model {str(model_path)!r}: observes {_shapes(model.observation_space)}, "
+                f"the env {env_id} gives {_shapes(env.observation_space)}; evaluate with the "
+                "env settings the model was trained with (hand, n, map window, "
+                "observation_mode)")
         venv = (batched_eval_env(env_id, kwargs, card.get("wrappers") or (),
                                  min(episodes, EVAL_BATCH))
                 if deterministic and not audit else None)

@@ -84,6 +84,7 @@ as any other (``tests/agents/test_policies.py``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from functools import partial
 from typing import Any
@@ -98,7 +99,8 @@ from graspgait_env.envs.observation import ObservationLayout
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["ENV_GEOMETRY", "FEATURE_SWITCHES", "REGRASP_CHANNELS", "GraspMapExtractor",
-           "MaskableRegraspScorerPolicy", "extractor_kwargs_for", "layout_of"]
+           "MaskableRegraspScorerPolicy", "PartsExtractor", "extractor_kwargs_for",
+           "layout_of"]
 
 REGRASP_CHANNELS = 9
 """Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
@@ -567,6 +569,75 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         return torch.cat(parts, dim=2)
 
 
+class PartsExtractor(BaseFeaturesExtractor):
+    """Features of the named-parts observation (``observation_mode="dict"``), read by name.
+
+    ``features_extractor: graspgait_env.agents.policies:PartsExtractor`` with ``policy:
+    graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` and ``env_kwargs:
+    {observation_mode: dict}``. Nothing is computed here that the env does not give: the
+    per-action features (legality, the turn achieved and the rotation room towards and
+    against the goal after the move, and the look-aheads' entries where the env has them:
+    :mod:`graspgait_env.envs.observation`) come from the ``actions`` part, whatever its
+    columns, so the same policy reads any set of opt-in fields.
+
+    The features are the **global context** (``grasp``, the ``legal`` column of
+    ``actions``, the ``window`` and ``lines`` parts flattened, and each feature column's
+    least and greatest value over the legal moves: what the best move offers), then the
+    **action block**: per action, its ``F`` features and, with ``relative``, each less its
+    least over the legal moves (0 for an illegal move), so that a shared scorer sees how
+    a move compares with the others. The policy keeps the block out of its MLPs and scores
+    every action from its row of it with one network
+    (:class:`MaskableRegraspScorerPolicy`).
+
+    Parameters
+    ----------
+    observation_space
+        The env's ``Dict`` observation space (SB3 passes it).
+    relative
+        Add each feature less its least over the legal moves to the block (default True).
+    """
+
+    def __init__(self, observation_space: gym.spaces.Dict, relative: bool = True) -> None:
+        from graspgait_env.envs.observation import ACTION_FEATURES
+
+        names = list(getattr(observation_space, "spaces", {}) or {})
+        if not isinstance(observation_space, gym.spaces.Dict) or not {
+                "grasp", "actions", "window"} <= set(names):
+            raise GraspGaitInputError(
+                f"observation space {observation_space!r}: PartsExtractor reads the named "
+                "parts (grasp, actions, window); set env_kwargs observation_mode: dict")
+        n_actions, n_features = observation_space["actions"].shape
+        self.legal = ACTION_FEATURES.index("legal")
+        self.relative = bool(relative)
+        self.names = [k for k in ("window", "lines") if k in names]
+        flat = sum(math.prod(observation_space[k].shape) for k in self.names)
+        width = int(observation_space["grasp"].shape[0]) + n_actions + flat + 2 * n_features
+        self.block_channels = n_features * (2 if self.relative else 1)
+        super().__init__(observation_space, width + n_actions * self.block_channels)
+        #: the scored block: where it starts in the features and the actions it scores
+        self.block_start = width
+        self.regrasp_actions = (0, int(n_actions))
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        """Features of a batch of named-parts observations, ``(batch, features_dim)``."""
+        act = observations["actions"]
+        b = act.shape[0]
+        legal = act[:, :, self.legal] > 0.5
+        big = torch.finfo(act.dtype).max
+        lo = torch.where(legal[:, :, None], act, big).amin(dim=1)
+        hi = torch.where(legal[:, :, None], act, -big).amax(dim=1)
+        none = ~legal.any(dim=1, keepdim=True)  # no legal move: 0, 0
+        lo, hi = lo.masked_fill(none, 0.0), hi.masked_fill(none, 0.0)
+        parts = [observations["grasp"], act[:, :, self.legal]]
+        parts += [observations[k].reshape(b, -1) for k in self.names]
+        parts += [lo, hi]
+        block = [act]
+        if self.relative:
+            block.append((act - lo[:, None, :]) * legal[:, :, None].to(act.dtype))
+        parts.append(torch.cat(block, dim=2).reshape(b, -1))
+        return torch.cat(parts, dim=1)
+
+
 class _ScorerExtractor(nn.Module):
     """SB3's ``MlpExtractor`` over the features before the regrasp block, and beside it
     the regrasp scorer: one small MLP, shared by every regrasp action, from that
@@ -630,10 +701,12 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     """sb3-contrib's maskable actor-critic with a **shared regrasp scorer**.
 
     ``policy: graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
-    ``algo: maskable_ppo`` and ``features_extractor:
-    graspgait_env.agents.policies:GraspMapExtractor`` with ``forward_gait: true``, which
-    gives it ``workspace_widths``, ``turn_steps`` and ``rotations``; the policy sets the
-    extractor's ``regrasp_block``).
+    ``algo: maskable_ppo`` and either ``features_extractor:
+    graspgait_env.agents.policies:PartsExtractor`` on the env's named parts,
+    ``observation_mode: dict``, where every action is scored from the env's per-action
+    features; or ``features_extractor: graspgait_env.agents.policies:GraspMapExtractor``
+    with ``forward_gait: true`` on the box observation, where the extractor computes the
+    regrasp block; the policy sets its ``regrasp_block``).
 
     Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent)
     and, for a regrasp action ``2R + 2q + l`` (thesis 4.2's move: the free finger to
@@ -668,15 +741,17 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     def __init__(self, *args: Any, scorer_arch: Sequence[int] = (32,), scorer_context: int = 16,
                  **kwargs: Any) -> None:
         extractor = kwargs.get("features_extractor_class")
-        if extractor is None or not issubclass(extractor, GraspMapExtractor):
+        if extractor is None or not issubclass(extractor, (GraspMapExtractor, PartsExtractor)):
             raise GraspGaitInputError(
                 f"policy MaskableRegraspScorerPolicy with features_extractor {extractor!r}: "
-                "needs graspgait_env.agents.policies:GraspMapExtractor (it computes the regrasp "
-                "block); "
-                "set features_extractor: graspgait_env.agents.policies:GraspMapExtractor with "
-                "features_extractor_kwargs forward_gait: true")
-        kwargs["features_extractor_kwargs"] = {**(kwargs.get("features_extractor_kwargs") or {}),
-                                               "regrasp_block": True}
+                "needs graspgait_env.agents.policies:PartsExtractor (the env's per-action "
+                "features, observation_mode: dict) or "
+                "graspgait_env.agents.policies:GraspMapExtractor with "
+                "features_extractor_kwargs forward_gait: true (it computes the regrasp "
+                "block)")
+        if issubclass(extractor, GraspMapExtractor):
+            kwargs["features_extractor_kwargs"] = {
+                **(kwargs.get("features_extractor_kwargs") or {}), "regrasp_block": True}
         if kwargs.get("share_features_extractor") is False:
             raise GraspGaitInputError("policy MaskableRegraspScorerPolicy: "
                                       "share_features_extractor=False is not supported; "

@@ -162,7 +162,8 @@ def test_scorer_policy_needs_maskable_ppo_and_the_extractor(tmp_path):
         TrainConfig(name="x", policy="MlpPolicy2")
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", _SCORER[0]])
     with pytest.raises(GraspGaitInputError,
-                       match="needs graspgait_env.agents.policies:GraspMapExtractor"):
+                       match="needs graspgait_env.agents.policies:PartsExtractor .*"
+                             "GraspMapExtractor"):
         build_model(cfg, make_vec_env_for(cfg))
 
 

@@ -1,0 +1,76 @@
+"""The shared scorer on the env's named parts: ``PartsExtractor`` reads the dict
+observation by name and adds nothing the env does not give."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+from graspgait_env.agents.card import load_agent, save_agent
+from graspgait_env.agents.config import load_train_config
+from graspgait_env.agents.evaluate import evaluate
+from graspgait_env.agents.policies import PartsExtractor
+from graspgait_env.agents.train import build_model, make_vec_env_for
+
+from graspgait_env.errors import GraspGaitInputError
+from tests.agents.helpers import assert_same_greedy_actions
+
+_PARTS = [
+    "env_kwargs={object: ellipse, mu: 0.7, observation_mode: dict, rotation_lookahead: true,"
+    " regrasp_lookahead: 1, map_window_cells: 3}",
+    "policy=graspgait_env.agents.policies:MaskableRegraspScorerPolicy",
+    "features_extractor=graspgait_env.agents.policies:PartsExtractor",
+]
+
+
+def _env(**kw):
+    return gym.make("graspgait_env:GraspGait-v0", object="ellipse", observation_mode="dict",
+                    **kw)
+
+
+def test_features_are_the_parts_and_each_move_against_the_best_legal_one():
+    env = _env(regrasp_lookahead=2, map_lines=True, turn_deg=-90.0)
+    ext = PartsExtractor(env.observation_space)
+    A, F = env.observation_space["actions"].shape
+    assert ext.regrasp_actions == (0, A) and ext.block_channels == 2 * F
+    rng = np.random.default_rng(2)
+    obs, info = env.reset(seed=4)
+    for _ in range(20):
+        t = {k: torch.as_tensor(v[None]) for k, v in obs.items()}
+        out = ext(t)[0].numpy()
+        assert out.shape == (ext.features_dim,)
+        act, legal = obs["actions"], info["action_mask"]
+        lo, hi = act[legal].min(axis=0), act[legal].max(axis=0)
+        head = np.concatenate([obs["grasp"], legal.astype(np.float32), obs["window"].ravel(),
+                               obs["lines"].ravel(), lo, hi])
+        np.testing.assert_allclose(out[:ext.block_start], head)
+        block = out[ext.block_start:].reshape(A, 2 * F)
+        np.testing.assert_array_equal(block[:, :F], act)
+        np.testing.assert_allclose(block[:, F:], (act - lo) * legal[:, None], atol=1e-6)
+        obs, _, term, trunc, info = env.step(int(rng.choice(np.flatnonzero(legal))))
+        if term or trunc:
+            obs, info = env.reset()
+
+
+def test_a_box_observation_is_refused_with_the_fix():
+    box = gym.make("graspgait_env:GraspGait-v0").observation_space
+    with pytest.raises(GraspGaitInputError, match="observation_mode: dict"):
+        PartsExtractor(box)
+
+
+def test_it_trains_saves_loads_and_evaluates_batched(tmp_path):
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    model.learn(128)
+    assert isinstance(model.policy.features_extractor, PartsExtractor)
+    path = save_agent(model, tmp_path / "m.zip", {"algo": cfg.algo, "env_id": cfg.env_id,
+                                                  "env_kwargs": cfg.env_kwargs})
+    loaded, _ = load_agent(path)
+    env = gym.make("graspgait_env:GraspGait-v0", **cfg.env_kwargs)
+    assert_same_greedy_actions(model, loaded, env)
+    res = evaluate(str(path), episodes=6)  # batched: the dict parts of 6 envs at a time
+    assert res["n_episodes"] == len(res["episodes"]) == 6
+    assert res["illegal_action_rate"] == 0.0
+    assert res["env_kwargs"]["observation_mode"] == "dict"
