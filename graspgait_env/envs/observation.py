@@ -270,35 +270,34 @@ class ObservationParts:
         lay, B, R2, K, sig = self.layout, box.shape[0], self._R2, self._K, self._sign
         W = self._W
         legal = box[:, lay.mask]
-        out = np.zeros((B, lay.n_actions, len(lay.action_features)), dtype=np.float32)
+        out = np.empty((B, lay.n_actions, len(lay.action_features)), dtype=np.float32)
         out[:, :, 0] = legal
         out[:, :, 1] = self._rotation
-        # rotation room now (GaitModel.rotation_room, thesis 5.2): ccw, cw
-        ccw = np.minimum(W[f] - 1 - p_f, W[g] - 1 - p_g)
-        cw = np.minimum(p_f, p_g)
+        inv = legal / K  # 1/K where legal, 0 where not: the three features below read 0
+        # rotation room now (GaitModel.rotation_room, thesis 5.2): ccw, cw; after rotating
+        # by d: ccw - d, cw + d
+        ccw = np.minimum(W[f] - 1 - p_f, W[g] - 1 - p_g)[:, None]
+        cw = np.minimum(p_f, p_g)[:, None]
         d = self._d
-        r_ccw = ccw[:, None] - d  # after rotating by d
-        r_cw = cw[:, None] + d
         # a regrasp (thesis 4.2): h to position p, lift l = 0 keeps g, l = 1 keeps f
         pos, lift = self._pos, self._lift
-        kept = np.where(lift == 0, g[:, None], f[:, None])
-        p_kept = np.where(lift == 0, p_g[:, None], p_f[:, None])
-        W_h = W[h][:, None]
-        g_ccw = np.minimum(W_h - 1 - pos, W[kept] - 1 - p_kept)
+        keep_g = lift == 0
+        kept = np.where(keep_g, g[:, None], f[:, None])
+        p_kept = np.where(keep_g, p_g[:, None], p_f[:, None])
+        g_ccw = np.minimum(W[h][:, None] - 1 - pos, W[kept] - 1 - p_kept)
         g_cw = np.minimum(pos, p_kept)
-        on = np.concatenate([r_ccw, g_ccw], axis=1) if sig > 0 else np.concatenate(
-            [r_cw, g_cw], axis=1)
-        back = np.concatenate([r_cw, g_cw], axis=1) if sig > 0 else np.concatenate(
-            [r_ccw, g_ccw], axis=1)
-        k_after = np.concatenate([k[:, None] + d, np.repeat(k[:, None], self._P2, axis=1)],
-                                 axis=1)
-        is_legal = legal > 0.5
-        out[:, :, 2] = np.where(is_legal, sig * k_after / K, 0.0)
-        out[:, :, 3] = np.where(is_legal, on / K, 0.0)
-        out[:, :, 4] = np.where(is_legal, back / K, 0.0)
+        r_on, r_back = (ccw - d, cw + d) if sig > 0 else (cw + d, ccw - d)
+        g_on, g_back = (g_ccw, g_cw) if sig > 0 else (g_cw, g_ccw)
+        out[:, :R2, 2] = sig * (k[:, None] + d) * inv[:, :R2]
+        out[:, R2:, 2] = sig * k[:, None] * inv[:, R2:]
+        out[:, :R2, 3] = r_on * inv[:, :R2]
+        out[:, R2:, 3] = g_on * inv[:, R2:]
+        out[:, :R2, 4] = r_back * inv[:, :R2]
+        out[:, R2:, 4] = g_back * inv[:, R2:]
         col = 5
         if lay.lookahead.stop > lay.lookahead.start:
             out[:, :R2, col] = box[:, lay.lookahead]
+            out[:, R2:, col] = 0.0  # a regrasp opens nothing
             col += 1
         D = lay.reach_depth
         if D:
