@@ -273,7 +273,7 @@ class ObservationParts:
         out = np.empty((B, lay.n_actions, len(lay.action_features)), dtype=np.float32)
         out[:, :, 0] = legal
         out[:, :, 1] = self._rotation
-        inv = legal / K  # 1/K where legal, 0 where not: the three features below read 0
+        on = legal  # 1 where legal, 0 where not: the three features below read 0 there
         # rotation room now (GaitModel.rotation_room, thesis 5.2): ccw, cw; after rotating
         # by d: ccw - d, cw + d
         ccw = np.minimum(W[f] - 1 - p_f, W[g] - 1 - p_g)[:, None]
@@ -288,12 +288,13 @@ class ObservationParts:
         g_cw = np.minimum(pos, p_kept)
         r_on, r_back = (ccw - d, cw + d) if sig > 0 else (cw + d, ccw - d)
         g_on, g_back = (g_ccw, g_cw) if sig > 0 else (g_cw, g_ccw)
-        out[:, :R2, 2] = sig * (k[:, None] + d) * inv[:, :R2]
-        out[:, R2:, 2] = sig * k[:, None] * inv[:, R2:]
-        out[:, :R2, 3] = r_on * inv[:, :R2]
-        out[:, R2:, 3] = g_on * inv[:, R2:]
-        out[:, :R2, 4] = r_back * inv[:, :R2]
-        out[:, R2:, 4] = g_back * inv[:, R2:]
+        out[:, :R2, 2] = sig * (k[:, None] + d) * on[:, :R2]
+        out[:, R2:, 2] = sig * k[:, None] * on[:, R2:]
+        out[:, :R2, 3] = r_on * on[:, :R2]
+        out[:, R2:, 3] = g_on * on[:, R2:]
+        out[:, :R2, 4] = r_back * on[:, :R2]
+        out[:, R2:, 4] = g_back * on[:, R2:]
+        out[:, :, 2:5] /= K  # grid steps over K, each rounded once (as the bounds)
         col = 5
         if lay.lookahead.stop > lay.lookahead.start:
             out[:, :R2, col] = box[:, lay.lookahead]

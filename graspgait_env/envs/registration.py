@@ -23,6 +23,7 @@ ENV_IDS: dict[str, str] = {
 # "vector_entry_point")` steps N copies in one NumPy call (other modes: "sync", "async")
 VECTOR_ENTRY_POINTS: dict[str, str] = {
     "GraspGait-v0": "graspgait_env.envs.vector_env:GraspGaitVectorEnv",
+    "GraspGaitRandom-v0": "graspgait_env.envs.vector_env:GraspGaitRandomVectorEnv",
 }
 
 

@@ -1,4 +1,5 @@
-"""Speed of the batched ``GraspGait-v0`` beside the single env, measured in one process.
+"""Speed of the batched ``GraspGait-v0`` beside the single env, and of the batched
+``GraspGaitRandom-v0`` beside ``SyncVectorEnv``, measured in one process.
 
 Run from the command line (``python -m graspgait_env.envs.vector_bench``) or through
 ``graspgait perf`` (listed in ``BENCHMARK_MODULES``).
@@ -31,17 +32,19 @@ from graspgait_env.envs.registration import register_envs
 from graspgait_env.envs.vector_env import sample_legal_actions
 from graspgait_env.timing import BenchRow, register
 
-__all__ = ["BATCH_NUM_ENVS", "RATIO_TARGET", "AIM_STEPS_PER_S", "batched_steps_per_s",
+__all__ = ["BATCH_NUM_ENVS", "RANDOM_NUM_ENVS", "RATIO_TARGET", "AIM_STEPS_PER_S", "batched_steps_per_s",
            "bench_batched", "bench_rows"]
 
 BATCH_NUM_ENVS = 256  # sub-envs of the batched env in the speed target
+RANDOM_NUM_ENVS = 64  # sub-envs of the batched GraspGaitRandom-v0 row
 RATIO_TARGET = 10.0  # batched env-steps/s over the single env's steps/s, same process
 AIM_STEPS_PER_S = 1_000_000.0  # (env-steps/s) the aim on this 2-core machine
 
 
 def batched_steps_per_s(num_envs: int = BATCH_NUM_ENVS, batch_steps: int = 1000,
-                        seed: int = 0, **kwargs: Any) -> float:
-    """Env-steps per second of the batched ``GraspGait-v0`` under masked random actions.
+                        seed: int = 0, env_id: str = "GraspGait-v0",
+                        mode: str = "vector_entry_point", **kwargs: Any) -> float:
+    """Env-steps per second of the batched ``env_id`` under masked random actions.
 
     Parameters
     ----------
@@ -51,12 +54,15 @@ def batched_steps_per_s(num_envs: int = BATCH_NUM_ENVS, batch_steps: int = 1000,
         Calls to ``step`` timed (``N * batch_steps`` env-steps).
     seed
         Reset seed and the seed of the uniforms.
+    env_id, mode
+        The id (``GraspGait-v0`` or ``GraspGaitRandom-v0``) and Gymnasium's
+        ``vectorization_mode``: ``"vector_entry_point"`` (the batched env) or ``"sync"``
+        (``SyncVectorEnv`` over single envs, the reference).
     **kwargs
-        ``GraspGait-v0`` keyword arguments.
+        The id's keyword arguments.
     """
     register_envs()
-    env = gym.make_vec("GraspGait-v0", num_envs=num_envs,
-                       vectorization_mode="vector_entry_point", **kwargs)
+    env = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode, **kwargs)
     u = np.random.default_rng(seed).random((batch_steps, num_envs))
     _, info = env.reset(seed=seed)
     mask = info["action_mask"]
@@ -92,12 +98,23 @@ def bench_batched(num_envs: int = BATCH_NUM_ENVS, batch_steps: int = 1000,
 
 @register
 def bench_rows(repeat: int) -> list[BenchRow]:
-    """Rows for ``graspgait perf``: batched env-steps/s at N = 256 and the ratio to one env."""
+    """Rows for ``graspgait perf``: batched env-steps/s at N = 256 and the ratio to one env;
+    the batched ``GraspGaitRandom-v0`` at N = 64 against ``SyncVectorEnv``."""
     rounds = max(1, min(3, repeat))
     res = bench_batched(rounds=rounds)
     b, s, ratio = res["batched_steps_per_s"], res["single_steps_per_s"], res["ratio"]
     n = BATCH_NUM_ENVS
+    # GraspGaitRandom-v0, each sub-env its own objects: the batched env against
+    # SyncVectorEnv over single envs (interleaved rounds, best of each)
+    rn, steps = RANDOM_NUM_ENVS, 300
+    pairs = [(batched_steps_per_s(rn, steps, r, env_id="GraspGaitRandom-v0", level=1),
+              batched_steps_per_s(rn, steps, r, env_id="GraspGaitRandom-v0", mode="sync",
+                                  level=1)) for r in range(rounds)]
+    rb, rs = (max(rates) for rates in zip(*pairs, strict=True))
     return [
+        BenchRow(f"GraspGaitRandom-v0 batched N={rn} / SyncVectorEnv", rb / rs, "x", "", None,
+                 f"{rb:.0f} against {rs:.0f} env-steps/s; level 1, masked random actions, "
+                 f"best of {rounds} x {steps} steps of {rn}, same process"),
         BenchRow(f"GraspGait-v0 batched N={n} env-steps/s", b, "steps/s", "", None,
                  f"aim {AIM_STEPS_PER_S:.0f}; make_vec vector_entry_point, masked random "
                  f"actions, best of {rounds} x 1000 steps of {n}"),

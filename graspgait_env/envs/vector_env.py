@@ -6,6 +6,11 @@ transitions are those of ``N`` single ``gymnasium.make("graspgait_env:GraspGait-
 envs under Gymnasium's ``SyncVectorEnv`` (next-step autoreset), bit for bit: the same
 observations, rewards, ``terminated``/``truncated`` (the 500-step time limit included)
 and infos, for the same seeds. See the class docstring.
+
+``gymnasium.make_vec("graspgait_env:GraspGaitRandom-v0", ...)`` makes a
+:class:`GraspGaitRandomVectorEnv`: the same step, each sub-env with its own objects and
+mu (each row reads its own grasp map), equal to ``SyncVectorEnv`` over
+``GraspGaitRandom-v0`` in the same way.
 """
 
 from __future__ import annotations
@@ -38,7 +43,8 @@ from graspgait_env.envs.registration import MAX_EPISODE_STEPS
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.shapes import Shape
 
-__all__ = ["GraspGaitVectorEnv", "SUPPORTED_FIELDS", "sample_legal_actions", "unsupported_fields"]
+__all__ = ["GraspGaitRandomVectorEnv", "GraspGaitVectorEnv", "SUPPORTED_FIELDS",
+           "sample_legal_actions", "unsupported_fields"]
 
 # The config fields whose every value the batched step implements. A field added to
 # GraspGaitConfig later is accepted at its default (opt-in fields change nothing there)
@@ -175,6 +181,17 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         copy: bool = True,
         **fields_: Any,
     ) -> None:
+        # The template: one single env checks the arguments (same messages) and holds
+        # the per-model tables that the batched step reads (one definition of each).
+        self._setup(GraspGaitEnv(object, mu, config=config, **fields_), num_envs,
+                    max_episode_steps, render_mode, copy)
+
+    # every sub-env plays the template's object (GraspGaitRandomVectorEnv: its own)
+    _per_row_objects: ClassVar[bool] = False
+
+    def _setup(self, env: GraspGaitEnv, num_envs: int, max_episode_steps: int | None,
+               render_mode: str | None, copy: bool) -> None:
+        """Everything but the template's construction: checks, spaces, tables, state."""
         N = check_count("num_envs", num_envs, 1, 16)
         if max_episode_steps is not None:
             max_episode_steps = check_count("max_episode_steps", max_episode_steps, 1,
@@ -186,9 +203,6 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
                 "render_mode=\"rgb_array\")")
         if not isinstance(copy, (bool, np.bool_)):
             raise GraspGaitInputError(f"copy={copy!r}: must be True or False")
-        # The template: one single env checks the arguments (same messages) and holds
-        # the per-model tables that the batched step reads (one definition of each).
-        env = GraspGaitEnv(object, mu, config=config, **fields_)
         _check_supported(env.config)
         self.template = env
         self.config = env.config
@@ -206,13 +220,14 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
 
         # per-sub-env reset: light copies of the template (shared model and tables, own
         # random generator), so starts are drawn by the single env's own code
-        starts = env.model.start_states()
-        env._starts = starts
-        # for autoresets in step (_autoreset_subs): each start's contacts and whether it
-        # has a legal move (the single env's _draw_start redraws those without one)
-        self._start_contacts = np.array([s.contacts for s in starts],
-                                        dtype=np.int64).reshape(-1, 3)
-        self._start_ok = [bool(env.model.action_mask(s).any()) for s in starts]
+        if not self._per_row_objects:
+            starts = env.model.start_states()
+            env._starts = starts
+            # for autoresets in step (_autoreset_subs): each start's contacts and whether
+            # it has a legal move (the single env's _draw_start redraws those without one)
+            self._start_contacts = np.array([s.contacts for s in starts],
+                                            dtype=np.int64).reshape(-1, 3)
+            self._start_ok = [bool(env.model.action_mask(s).any()) for s in starts]
         self._subs: list[GraspGaitEnv] = []
         for _ in range(N):
             sub = _copy_env(env)
@@ -304,6 +319,15 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # column by column and written into the observation rows in one assignment
         self._head = np.zeros((N, _HEADER), dtype=np.float32)
         self._started = False
+        if self._per_row_objects:
+            # each sub-env's own object: its model's tables per row, refreshed whenever
+            # its reset draws a new object (_refresh_rows); the hand, grid and turn, so
+            # the action space and every table above, are the same for every object
+            self._row_model: list[Any] = [None] * N
+            self._row_runs = np.zeros((N, self._n * self._n, self._P), dtype=bool)
+            self._row_base = self._arN * (self._n * self._n)
+            self._row_windows: list[Any] = [None] * N
+            self._row_lines: list[Any] = [None] * N
 
     def _rotation_tables(self, model: Any) -> None:
         """The rotation block of the mask (its first ``2R`` entries) from a table.
@@ -390,7 +414,30 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             self._k[i] = s.k
             self._c[i] = s.contacts
             infos = self._add_info(infos, info, i)
+        if self._per_row_objects:
+            self._refresh_rows(idx)
         self._load_starts(np.asarray(idx, dtype=np.int64))
+
+    def _refresh_rows(self, idx: Sequence[int]) -> None:
+        """Per-row tables of sub-envs ``idx`` whose reset drew a new object: the runs of
+        its grasp map (the mask's regrasp rule), its map-window views and map lines."""
+        n, P, C = self._n, self._P, self.config.map_window_cells
+        for i in idx:
+            sub = self._subs[i]
+            if sub.model is self._row_model[i]:
+                continue
+            self._row_model[i] = sub.model
+            rows = np.ascontiguousarray(sub.model.grasp_map.extended().T)
+            runs = np.lib.stride_tricks.sliding_window_view(rows, P, axis=1)
+            self._row_runs[i] = runs[:n, :n].reshape(n * n, P)
+            self._row_windows[i] = _window_views(sub._pooled, sub._stride, C)
+            self._row_lines[i] = (None if sub._line_src is None else
+                                  np.lib.stride_tricks.sliding_window_view(sub._line_src, n,
+                                                                           axis=1))
+
+    def _model_of(self, i: int) -> Any:
+        """The gait model of sub-env ``i``."""
+        return self._subs[i].model if self._per_row_objects else self.model
 
     def _load_starts(self, idx: NDArray[np.int64]) -> None:
         """Batched state of sub-envs ``idx`` whose contacts ``_c`` were just set to a
@@ -412,8 +459,8 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             from graspgait_env.gait import GaitState
 
             for i in idx.tolist():
-                self._togo_now[i] = self._to_go(GaitState(int(self._k[i]),
-                                                          tuple(self._c[i].tolist())))
+                to_go = self._subs[i]._to_go if self._per_row_objects else self._to_go
+                self._togo_now[i] = to_go(GaitState(int(self._k[i]), tuple(self._c[i].tolist())))
         self._elapsed[idx] = 0
         self._autoreset[idx] = False
 
@@ -428,6 +475,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         :meth:`step`. The reset infos that the step does not overwrite, ``object`` and
         ``mu``, are batched as ``SyncVectorEnv`` batches them (``_add_info``).
         """
+        if self._per_row_objects:  # each its own object: the single env's whole reset
+            idx_list = idx.tolist()
+            self._reset_subs(idx_list, [None] * len(idx_list), None, infos)
+            return
         has_move = self._start_ok.__getitem__
         L = len(self._start_ok)
         # never None: the first reset found a start with a legal move
@@ -542,7 +593,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         i0 = (self._ws_start.take(h) - self._k) % n
         valid, b = self._valid.take(h, axis=0), 2 * R
         cg, cf = c.take(row3 + g), c.take(row3 + f)
-        if self._runs_table is not None:
+        if self._per_row_objects:  # each row its own grasp map
+            flat = self._row_runs.reshape(-1, self._P)
+            run_g = flat.take(self._row_base + cg * n + i0, axis=0)
+            run_f = flat.take(self._row_base + cf * n + i0, axis=0)
+        elif self._runs_table is not None:
             run_g = self._runs_table.take(cg * n + i0, axis=0)
             run_f = self._runs_table.take(cf * n + i0, axis=0)
         else:
@@ -554,10 +609,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             mask[self._last_turn > 0, R:2 * R] = False
             mask[self._last_turn < 0, :R] = False
         if self._visited is not None:  # the single env's rule, row by row
-            model = self.model
             for i, vis in enumerate(self._visited):
-                drop_revisits(model, mask[i], int(self._k[i]), tuple(self._c[i].tolist()),
-                              *vis)
+                drop_revisits(self._model_of(i), mask[i], int(self._k[i]),
+                              tuple(self._c[i].tolist()), *vis)
 
     def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
         """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
@@ -565,8 +619,10 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         from graspgait_env.gait import GaitState
 
         before = self._togo_now[idx]
-        now = np.array([self._to_go(GaitState(int(k), tuple(int(x) for x in c)))
-                        for k, c in zip(self._k[idx], self._c[idx], strict=True)],
+        to_go = ([self._subs[i]._to_go for i in idx.tolist()] if self._per_row_objects
+                 else [self._to_go] * idx.size)
+        now = np.array([t(GaitState(int(k), tuple(int(x) for x in c)))
+                        for t, k, c in zip(to_go, self._k[idx], self._c[idx], strict=True)],
                        dtype=np.int64)
         self._togo_now[idx] = now
         return before - now
@@ -577,8 +633,14 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         n, c, at = self._n, self._c.ravel(), 3 * idx
         i0 = (c.take(at + self._f.take(idx)) - self._win_back) % n
         j0 = (c.take(at + self._g.take(idx)) - self._win_back) % n
-        s = self._windows.shape[0]
-        win = self._windows[i0 % s, j0 % s, i0 // s, j0 // s]
+        if self._per_row_objects:  # each row its own map
+            s = self._row_windows[int(idx[0])].shape[0]
+            win = np.stack([self._row_windows[i][a % s, b % s, a // s, b // s]
+                            for i, a, b in zip(idx.tolist(), i0.tolist(), j0.tolist(),
+                                               strict=True)])
+        else:
+            s = self._windows.shape[0]
+            win = self._windows[i0 % s, j0 % s, i0 // s, j0 // s]
         self._obs[idx, self.layout.window] = win.reshape(idx.size, -1)
 
     def step(self, actions: Any) -> tuple[NDArray[np.float32], NDArray[np.float64],
@@ -642,19 +704,39 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         if self._lines is not None:  # thesis 4.3: the regrasps keeping f or g
             shift = -k % n
             lines = o[:, self.layout.lines].reshape(N, 2, n)
-            lines[:, 0] = self._lines[c[self._arN, self._f], shift]
-            lines[:, 1] = self._lines[c[self._arN, self._g], shift]
+            cf, cg = c[self._arN, self._f], c[self._arN, self._g]
+            if self._per_row_objects:  # each row its own map
+                for i, src in enumerate(self._row_lines):
+                    lines[i, 0] = src[cf[i], shift[i]]
+                    lines[i, 1] = src[cg[i], shift[i]]
+            else:
+                lines[:, 0] = self._lines[cf, shift]
+                lines[:, 1] = self._lines[cg, shift]
         if self._openings is not None:  # thesis 4.2, 5.2: the regrasps a rotation opens
             h = self._h[:, None]
             i = (self._ws_start[h] - k[:, None] - self._rot_delta) % n
-            opens = (self._openings[h, c[self._arN, self._f][:, None], i]
-                     | self._openings[h, c[self._arN, self._g][:, None], i])
+            cf, cg = c[self._arN, self._f][:, None], c[self._arN, self._g][:, None]
+            if self._per_row_objects:  # each row its own table
+                opens = np.concatenate([
+                    self._subs[r]._openings[h[r], cf[r], i[r]]
+                    | self._subs[r]._openings[h[r], cg[r], i[r]] for r in range(N)])
+                opens = opens.reshape(N, -1)
+            else:
+                opens = self._openings[h, cf, i] | self._openings[h, cg, i]
             np.logical_and(opens, mask[:, :2 * R], out=opens)
             o[:, self.layout.lookahead] = opens
         if self._reach is not None:  # the reach look-ahead, every row
             arN, f, g = self._arN, self._f, self._g
-            o[:, self.layout.reach] = self._reach.move_shortfalls_batch(
-                self._h, f, g, p[arN, f], p[arN, g], k, mask, self._rot_delta)
+            pf, pg = p[arN, f], p[arN, g]
+            if self._per_row_objects:  # each row its own tables
+                for r in range(N):
+                    sl = slice(r, r + 1)
+                    o[sl, self.layout.reach] = self._subs[r]._reach.move_shortfalls_batch(
+                        self._h[sl], f[sl], g[sl], pf[sl], pg[sl], k[sl], mask[sl],
+                        self._rot_delta)
+            else:
+                o[:, self.layout.reach] = self._reach.move_shortfalls_batch(
+                    self._h, f, g, pf, pg, k, mask, self._rot_delta)
         # episode ends and reward (GraspGaitEnv._reward's table, term by term, same order)
         is_success = self._k_success[ki]
         terminated = live & (self._k_ends[ki] | ~mask.any(axis=1))
@@ -698,6 +780,48 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
 
     def close_extras(self, **kwargs: Any) -> None:
         """Nothing to release (no renderer, no processes)."""
+
+
+class GraspGaitRandomVectorEnv(GraspGaitVectorEnv):
+    """``GraspGaitRandom-v0`` batched: ``N`` sub-envs, each with its own object and mu.
+
+    ``gymnasium.make_vec("graspgait_env:GraspGaitRandom-v0", num_envs=N,
+    vectorization_mode="vector_entry_point", **kwargs)``. Each sub-env is a
+    :class:`~graspgait_env.envs.random_env.GraspGaitRandomEnv` of its own (a light copy
+    of one template, with its own generator), which draws its objects, frictions and
+    starts with the single env's own ``reset``, at the first reset, at every autoreset
+    and with ``reset(options=...)`` (``object``, ``object_seed``, ``mu``, ``start``).
+    The moves, masks, observations and rewards of every sub-env are then computed for
+    the batch in one NumPy call, as for ``GraspGait-v0``
+    (:class:`GraspGaitVectorEnv`), reading each row's own grasp map; the tables that
+    one object's look-aheads need (``map_lines``, ``rotation_lookahead``,
+    ``regrasp_lookahead``, ``to_go_weight``) are read row by row. The transitions are
+    those of ``N`` single ``gymnasium.make("graspgait_env:GraspGaitRandom-v0")`` envs
+    under ``SyncVectorEnv``, bit for bit, for the same seeds (the tests compare them).
+    The hand, the grid and the turn are the same for every object (the single env
+    checks it), so are the spaces.
+
+    Parameters
+    ----------
+    num_envs, max_episode_steps, copy
+        As :class:`GraspGaitVectorEnv`.
+    render_mode
+        Must be None.
+    **kwargs
+        The arguments of ``GraspGaitRandom-v0`` (``level``, ``mu_range``,
+        ``object_seeds``, ``exclude_seeds``, ``bundled_fraction``,
+        ``episodes_per_object``, ``config`` and the config fields), checked with the
+        same messages.
+    """
+
+    _per_row_objects: ClassVar[bool] = True
+
+    def __init__(self, num_envs: int = 1, *, max_episode_steps: int | None = MAX_EPISODE_STEPS,
+                 render_mode: str | None = None, copy: bool = True, **kwargs: Any) -> None:
+        from graspgait_env.envs.random_env import GraspGaitRandomEnv
+
+        self._setup(GraspGaitRandomEnv(**kwargs), num_envs, max_episode_steps, render_mode,
+                    copy)
 
 
 def sample_legal_actions(masks: NDArray[np.bool_], u: NDArray[np.floating]) -> NDArray[np.int64]:

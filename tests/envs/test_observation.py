@@ -50,6 +50,7 @@ def _rollout(steps: int, seed: int, **kw):
     {"object": "ellipse", "turn_deg": 90.0},
     {"object": "pentagon", "turn_deg": -60.0, "mu": 0.5},
     {"object": "hexagon", "turn_deg": 45.0, "contact_model": "hand"},
+    {"object": "circle", "turn_deg": 30.0},  # room / K = 3 exactly at the bound
 ])
 def test_action_features_are_what_each_move_leads_to(kw):
     """``achieved``, ``room_on`` and ``room_back`` of every legal action equal the
@@ -62,6 +63,7 @@ def test_action_features_are_what_each_move_leads_to(kw):
         lay = u.layout
         act = obs["actions"]
         assert act.shape == (model.n_actions, len(ACTION_FEATURES))
+        assert u.observation_space.contains(obs)
         col = {name: lay.feature(name) for name in ACTION_FEATURES}
         mask = info["action_mask"]
         np.testing.assert_array_equal(act[:, col["legal"]], mask.astype(np.float32))

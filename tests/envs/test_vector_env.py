@@ -19,12 +19,16 @@ from graspgait_env.errors import GraspGaitInputError
 ID = "graspgait_env:GraspGait-v0"
 
 
-def _batched(num_envs: int, **kw) -> gym.vector.VectorEnv:
-    return gym.make_vec(ID, num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
+RANDOM_ID = "graspgait_env:GraspGaitRandom-v0"
 
 
-def _sync(num_envs: int, **kw) -> gym.vector.VectorEnv:
-    return gym.make_vec(ID, num_envs=num_envs, vectorization_mode="sync", **kw)
+def _batched(num_envs: int, env_id: str = ID, **kw) -> gym.vector.VectorEnv:
+    return gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point",
+                        **kw)
+
+
+def _sync(num_envs: int, env_id: str = ID, **kw) -> gym.vector.VectorEnv:
+    return gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="sync", **kw)
 
 
 def assert_same(x, y, path="") -> None:
@@ -62,9 +66,10 @@ def masked_actions(masks: np.ndarray, rng: np.random.Generator,
                      for m, j in zip(masks, pick, strict=True)])
 
 
-def compare_rollouts(num_envs: int, seed: int, steps: int, **kw) -> dict[str, int]:
+def compare_rollouts(num_envs: int, seed: int, steps: int, env_id: str = ID,
+                     **kw) -> dict[str, int]:
     """Step the batched and the sync env side by side; return counts of episode ends."""
-    a, b = _batched(num_envs, **kw), _sync(num_envs, **kw)
+    a, b = _batched(num_envs, env_id, **kw), _sync(num_envs, env_id, **kw)
     obs_a, info_a = a.reset(seed=seed)
     obs_b, info_b = b.reset(seed=seed)
     assert_same(obs_a, obs_b)
@@ -137,19 +142,57 @@ def test_same_transitions_with_config_fields(kw):
     compare_rollouts(3, 11, 100, **kw)
 
 
-def test_the_config_cases_set_every_field_off_its_default():
-    """The equality test above covers every config field, each away from its default in
-    at least one case (a field added to the config needs a case here)."""
+# GraspGaitRandom-v0: each sub-env its own objects and mu (short turns: many episodes,
+# so many objects)
+RANDOM_CASES = [
+    {"level": 0, "turn_deg": 40.0, "max_backward_deg": 10.0},
+    {"level": 2, "episodes_per_object": 3, "regrasp_lookahead": 2, "map_lines": True,
+     "rotation_lookahead": True, "n": 90, "turn_deg": 40.0, "max_backward_deg": 10.0},
+    {"level": 1, "mu_range": (0.4, 0.8), "contact_model": "hand", "to_go_weight": 1.0,
+     "forbid_revisit": True, "forbid_reversal": True, "observation_mode": "dict",
+     "turn_deg": -40.0},
+    {"level": 3, "bundled_fraction": 1.0, "hand": "thesis", "alpha": 2.0, "beta": 0.5,
+     "gamma": 0.1, "turn_scale_deg": 30.0, "success_bonus": 2.0, "dead_end_penalty": 2.0,
+     "illegal_penalty": 0.2, "map_window_deg": 60.0, "map_window_cells": 5,
+     "observation_mode": "flat", "turn_deg": 30.0, "max_episode_steps": 40},
+]
+
+
+@pytest.mark.parametrize("kw", RANDOM_CASES)
+def test_random_objects_batched_as_single_envs(kw):
+    ends = compare_rollouts(3, 4, 80, RANDOM_ID, **kw)
+    assert sum(ends.values()) > 0
+
+
+@pytest.mark.parametrize("cases", [CONFIG_CASES, RANDOM_CASES], ids=["GraspGait", "Random"])
+def test_the_config_cases_set_every_field_off_its_default(cases):
+    """The equality tests above cover every config field, each away from its default in
+    at least one case, for both ids (a field added to the config needs a case here)."""
     from dataclasses import fields
 
     from graspgait_env.envs.config import GraspGaitConfig
 
     default = GraspGaitConfig()
-    covered = {name for kw in CONFIG_CASES for name, value in kw.items()
+    covered = {name for kw in cases for name, value in kw.items()
                if name in GraspGaitConfig.field_names()
                and (name == "hand" or value != getattr(default, name))}
     missing = [f.name for f in fields(GraspGaitConfig) if f.name not in covered]
-    assert not missing, f"no case of CONFIG_CASES sets {missing} off its default"
+    assert not missing, f"no case sets {missing} off its default"
+
+
+def test_random_sub_envs_draw_their_own_objects_and_take_per_env_options():
+    envs = _batched(4, RANDOM_ID, level=1, turn_deg=40.0)
+    _, info = envs.reset(seed=0)
+    assert len(set(info["object_seed"].tolist())) == 4  # four objects, one per sub-env
+    assert len(set(info["mu"].tolist())) == 4
+    m = np.array([False, True, False, False])
+    obs, info = envs.reset(options={"object": "pentagon", "mu": 0.6, "reset_mask": m})
+    assert info["_object"].tolist() == [False, True, False, False]
+    assert info["object"][1] == "pentagon" and info["mu"][1] == 0.6
+    u = envs.unwrapped
+    assert u.states()[1] == u._subs[1].state
+    np.testing.assert_array_equal(info["action_mask"][1],
+                                  u._subs[1].model.action_mask(u._subs[1].state))
 
 
 def test_reset_mask_and_start_option_match_sync():
