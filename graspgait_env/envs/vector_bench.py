@@ -32,8 +32,8 @@ from graspgait_env.envs.registration import register_envs
 from graspgait_env.envs.vector_env import sample_legal_actions
 from graspgait_env.timing import BenchRow, register
 
-__all__ = ["BATCH_NUM_ENVS", "RANDOM_NUM_ENVS", "RATIO_TARGET", "AIM_STEPS_PER_S", "batched_steps_per_s",
-           "bench_batched", "bench_rows"]
+__all__ = ["BATCH_NUM_ENVS", "RANDOM_NUM_ENVS", "RATIO_TARGET", "AIM_STEPS_PER_S",
+           "batched_steps_per_s", "bench_batched", "bench_rows"]
 
 BATCH_NUM_ENVS = 256  # sub-envs of the batched env in the speed target
 RANDOM_NUM_ENVS = 64  # sub-envs of the batched GraspGaitRandom-v0 row
