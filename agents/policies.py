@@ -595,9 +595,14 @@ class PartsExtractor(BaseFeaturesExtractor):
         The env's ``Dict`` observation space (SB3 passes it).
     relative
         Add each feature less its least over the legal moves to the block (default True).
+    extremes
+        Add, per feature, 1 for the legal moves at its least and 1 for those at its
+        greatest value (two one-hot codes of ``F`` entries each; default False): which
+        moves are the best by each feature, whichever way is better.
     """
 
-    def __init__(self, observation_space: gym.spaces.Dict, relative: bool = True) -> None:
+    def __init__(self, observation_space: gym.spaces.Dict, relative: bool = True,
+                 extremes: bool = False) -> None:
         from graspgait_env.envs.observation import ACTION_FEATURES
 
         names = list(getattr(observation_space, "spaces", {}) or {})
@@ -609,10 +614,11 @@ class PartsExtractor(BaseFeaturesExtractor):
         n_actions, n_features = observation_space["actions"].shape
         self.legal = ACTION_FEATURES.index("legal")
         self.relative = bool(relative)
+        self.extremes = bool(extremes)
         self.names = [k for k in ("window", "lines") if k in names]
         flat = sum(math.prod(observation_space[k].shape) for k in self.names)
         width = int(observation_space["grasp"].shape[0]) + n_actions + flat + 2 * n_features
-        self.block_channels = n_features * (2 if self.relative else 1)
+        self.block_channels = n_features * (1 + self.relative + 2 * self.extremes)
         super().__init__(observation_space, width + n_actions * self.block_channels)
         #: the scored block: where it starts in the features and the actions it scores
         self.block_start = width
@@ -632,8 +638,12 @@ class PartsExtractor(BaseFeaturesExtractor):
         parts += [observations[k].reshape(b, -1) for k in self.names]
         parts += [lo, hi]
         block = [act]
+        on = legal[:, :, None].to(act.dtype)
         if self.relative:
-            block.append((act - lo[:, None, :]) * legal[:, :, None].to(act.dtype))
+            block.append((act - lo[:, None, :]) * on)
+        if self.extremes:  # 1e-6: the features are exact multiples of 1 / K or 0 / 1
+            block.append((act <= lo[:, None, :] + 1e-6).to(act.dtype) * on)
+            block.append((act >= hi[:, None, :] - 1e-6).to(act.dtype) * on)
         parts.append(torch.cat(block, dim=2).reshape(b, -1))
         return torch.cat(parts, dim=1)
 

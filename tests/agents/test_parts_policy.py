@@ -53,6 +53,20 @@ def test_features_are_the_parts_and_each_move_against_the_best_legal_one():
             obs, info = env.reset()
 
 
+def test_extremes_mark_the_best_legal_moves_by_each_feature():
+    env = _env(regrasp_lookahead=2)
+    ext = PartsExtractor(env.observation_space, relative=False, extremes=True)
+    A, F = env.observation_space["actions"].shape
+    assert ext.block_channels == 3 * F
+    obs, info = env.reset(seed=2)
+    t = {k: torch.as_tensor(v[None]) for k, v in obs.items()}
+    block = ext(t)[0, ext.block_start:].numpy().reshape(A, 3 * F)
+    act, legal = obs["actions"], info["action_mask"]
+    lo, hi = act[legal].min(axis=0), act[legal].max(axis=0)
+    np.testing.assert_array_equal(block[:, F:2 * F], (act == lo) & legal[:, None])
+    np.testing.assert_array_equal(block[:, 2 * F:], (act == hi) & legal[:, None])
+
+
 def test_a_box_observation_is_refused_with_the_fix():
     box = gym.make("graspgait_env:GraspGait-v0").observation_space
     with pytest.raises(GraspGaitInputError, match="observation_mode: dict"):
