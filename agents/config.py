@@ -47,7 +47,8 @@ ALGOS = ("maskable_ppo", "ppo")
 VEC_ENVS = ("dummy", "subproc", "batched")
 """SB3 vector envs: ``dummy`` steps the envs in this process, one after the other;
 ``subproc`` runs one process per env; ``batched`` steps all ``n_envs`` in one NumPy call
-(:mod:`graspgait_env.agents.vec_env`; ``GraspGait-v0`` without wrappers only, same transitions)."""
+(:mod:`graspgait_env.agents.vec_env`; ``GraspGait-v0`` and ``GraspGaitRandom-v0`` without
+wrappers only, same transitions)."""
 ACTIVATIONS = ("tanh", "relu")
 
 

@@ -153,13 +153,13 @@ def make_vec_env_for(config: TrainConfig, n_envs: int | None = None) -> Any:
     if config.vec_env == "batched":
         from graspgait_env.agents.vec_env import make_batched_vec_env
 
-        if env_id != "GraspGait-v0" or wrappers:
+        if env_id not in ("GraspGait-v0", "GraspGaitRandom-v0") or wrappers:
             raise GraspGaitInputError(
                 f"vec_env='batched' with env_id={env_id!r}, wrappers={list(wrappers)}: the "
-                "batched env is GraspGait-v0 without wrappers or train_wrappers; use "
-                "vec_env=dummy")
+                "batched envs are GraspGait-v0 and GraspGaitRandom-v0 without wrappers or "
+                "train_wrappers; use vec_env=dummy")
         return make_batched_vec_env(n_envs or config.n_envs, seed=config.seed,
-                                    env_kwargs=kwargs)
+                                    env_kwargs=kwargs, env_id=env_id)
     cls = SubprocVecEnv if config.vec_env == "subproc" else DummyVecEnv
     return make_vec_env(lambda: make_env(env_id, kwargs, wrappers),
                         n_envs=n_envs or config.n_envs, seed=config.seed, vec_env_cls=cls)

@@ -184,8 +184,9 @@ def _copy(obs: Any, row: int | None = None) -> Any:
 def make_batched_vec_env(n_envs: int, seed: int | None = None,
                          env_kwargs: Mapping[str, Any] | None = None,
                          max_episode_steps: int | None = MAX_EPISODE_STEPS,
-                         monitor: bool = True) -> VecEnv:
-    """``GraspGait-v0`` batched for SB3: the counterpart of ``make_vec_env`` + Monitor.
+                         monitor: bool = True, env_id: str = "GraspGait-v0") -> VecEnv:
+    """``GraspGait-v0`` (or ``GraspGaitRandom-v0``) batched for SB3: the counterpart of
+    ``make_vec_env`` + Monitor.
 
     Parameters
     ----------
@@ -195,19 +196,30 @@ def make_batched_vec_env(n_envs: int, seed: int | None = None,
         Sub-env ``i`` is reset with ``seed + i`` at the first ``reset()`` (None: fresh
         entropy), as SB3's ``make_vec_env`` seeds.
     env_kwargs
-        ``GraspGait-v0``'s keyword arguments (``object``, ``mu``, GraspGaitConfig fields).
+        The id's keyword arguments (``object``, ``mu``, GraspGaitConfig fields; for
+        ``GraspGaitRandom-v0`` ``level``, ``mu_range``, ...).
     max_episode_steps
         The time limit (500, the registered one).
     monitor
         Wrap in ``VecMonitor`` (episode returns, lengths and success in SB3's logs).
+    env_id
+        ``GraspGait-v0`` (:class:`GraspGaitVectorEnv`) or ``GraspGaitRandom-v0``
+        (:class:`~graspgait_env.envs.vector_env.GraspGaitRandomVectorEnv`, each sub-env
+        its own objects).
 
     Returns
     -------
     VecEnv
         :class:`GraspGaitVecEnv`, in ``VecMonitor`` when ``monitor``.
     """
-    venv = GraspGaitVectorEnv(n_envs, max_episode_steps=max_episode_steps,
-                              **dict(env_kwargs or {}))
+    from graspgait_env.envs.vector_env import GraspGaitRandomVectorEnv
+
+    classes = {"GraspGait-v0": GraspGaitVectorEnv, "GraspGaitRandom-v0": GraspGaitRandomVectorEnv}
+    if env_id not in classes:
+        raise GraspGaitInputError(f"env_id={env_id!r}: the batched envs are "
+                                  f"{', '.join(classes)}; use SB3's make_vec_env for others")
+    venv = classes[env_id](n_envs, max_episode_steps=max_episode_steps,
+                           **dict(env_kwargs or {}))
     env: VecEnv = GraspGaitVecEnv(venv)
     if seed is not None:
         env.seed(seed)

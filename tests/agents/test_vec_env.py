@@ -25,15 +25,18 @@ def _assert_equal(x, y) -> None:
         np.testing.assert_array_equal(x, y)
 
 
-@pytest.mark.parametrize(("n_envs", "mode"), [(1, "box"), (5, "box"), (5, "dict")])
-def test_same_transitions_as_dummy_vec_env(n_envs, mode):
+@pytest.mark.parametrize(("n_envs", "mode", "env_id"), [
+    (1, "box", "GraspGait-v0"), (5, "box", "GraspGait-v0"), (5, "dict", "GraspGait-v0"),
+    (3, "box", "GraspGaitRandom-v0")])
+def test_same_transitions_as_dummy_vec_env(n_envs, mode, env_id):
     """SB3's autoreset, terminal observations, time-limit flags and float32 rewards, as
     DummyVecEnv over gymnasium.make gives them (short turns: many episode ends)."""
     from stable_baselines3.common.env_util import make_vec_env
 
     kw = {"turn_deg": 20.0, "max_backward_deg": 10.0, "observation_mode": mode}
-    a = make_batched_vec_env(n_envs, seed=3, env_kwargs=kw, max_episode_steps=60)
-    b = make_vec_env(lambda: gym.make("GraspGait-v0", max_episode_steps=60, **kw),
+    a = make_batched_vec_env(n_envs, seed=3, env_kwargs=kw, max_episode_steps=60,
+                             env_id=env_id)
+    b = make_vec_env(lambda: gym.make(env_id, max_episode_steps=60, **kw),
                      n_envs=n_envs, seed=3)
     _assert_equal(a.reset(), b.reset())
     rng = np.random.default_rng(0)
