@@ -40,7 +40,7 @@ With ``R = max_f W_f - 1`` (the longest rotation) and ``P = max_f W_f``:
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,7 +53,7 @@ from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand, load_hand
 
 __all__ = ["GaitModel", "GaitState", "Move", "ROTATE", "REGRASP", "workspace_grid",
-           "MAX_PLAN_N", "MAX_TURN_STEPS"]
+           "rotation_room_of", "MAX_PLAN_N", "MAX_TURN_STEPS"]
 
 ROTATE = "rotate"
 REGRASP = "regrasp"
@@ -103,6 +103,16 @@ def workspace_grid(workspaces_deg, n: int) -> tuple[NDArray[np.int64], NDArray[n
         starts.append(a0)
         widths.append(a1 - a0 + 1)
     return np.array(starts, dtype=np.int64), np.array(widths, dtype=np.int64)
+
+
+def rotation_room_of(ws_width: Any, f: Any, pf: Any, g: Any, pg: Any) -> tuple[Any, Any]:
+    """:meth:`GaitModel.rotation_room` elementwise over NumPy arrays (thesis 5.2): the
+    grid steps ``(ccw, cw)`` that fingers ``f``, ``g`` (finger indices, arrays allowed)
+    at workspace positions ``pf``, ``pg`` may turn, with workspace widths ``ws_width``
+    (grid points per finger): ``ccw = min(W_f - 1 - pf, W_g - 1 - pg)``, ``cw = min(pf,
+    pg)``. Symmetric in the two fingers."""
+    W = np.asarray(ws_width)
+    return np.minimum(W[f] - 1 - pf, W[g] - 1 - pg), np.minimum(pf, pg)
 
 
 class GaitState(NamedTuple):
@@ -219,10 +229,10 @@ class GaitModel:
         ``ccw = min(W_f - 1 - pf, W_g - 1 - pg)``, ``cw = min(pf, pg)``. Positions grow
         counter-clockwise; arguments may be NumPy arrays (elementwise).
         """
+        if not isinstance(pf, int):
+            return rotation_room_of(self.ws_width, f, pf, g, pg)
         wd = self._widths
-        return (np.minimum(wd[f] - 1 - pf, wd[g] - 1 - pg) if not isinstance(pf, int)
-                else min(wd[f] - 1 - pf, wd[g] - 1 - pg),
-                np.minimum(pf, pg) if not isinstance(pf, int) else min(pf, pg))
+        return min(wd[f] - 1 - pf, wd[g] - 1 - pg), min(pf, pg)
 
     def state_rotation_room(self, s: GaitState) -> tuple[int, int]:
         """:meth:`rotation_room` of the two fingers holding state ``s``."""

@@ -58,6 +58,7 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.gait import rotation_room_of
 
 __all__ = ["ACTION_FEATURES", "GRASP_FIELDS", "OBSERVATION_MODES", "ObservationLayout",
            "ObservationParts", "PARTS", "check_observation_mode"]
@@ -276,16 +277,14 @@ class ObservationParts:
         on = legal  # 1 where legal, 0 where not: the three features below read 0 there
         # rotation room now (GaitModel.rotation_room, thesis 5.2): ccw, cw; after rotating
         # by d: ccw - d, cw + d
-        ccw = np.minimum(W[f] - 1 - p_f, W[g] - 1 - p_g)[:, None]
-        cw = np.minimum(p_f, p_g)[:, None]
+        ccw, cw = (x[:, None] for x in rotation_room_of(W, f, p_f, g, p_g))
         d = self._d
         # a regrasp (thesis 4.2): h to position p, lift l = 0 keeps g, l = 1 keeps f
         pos, lift = self._pos, self._lift
         keep_g = lift == 0
         kept = np.where(keep_g, g[:, None], f[:, None])
         p_kept = np.where(keep_g, p_g[:, None], p_f[:, None])
-        g_ccw = np.minimum(W[h][:, None] - 1 - pos, W[kept] - 1 - p_kept)
-        g_cw = np.minimum(pos, p_kept)
+        g_ccw, g_cw = rotation_room_of(W, h[:, None], pos, kept, p_kept)
         r_on, r_back = (ccw - d, cw + d) if sig > 0 else (cw + d, ccw - d)
         g_on, g_back = (g_ccw, g_cw) if sig > 0 else (g_cw, g_ccw)
         out[:, :R2, 2] = sig * (k[:, None] + d) * on[:, :R2]

@@ -240,11 +240,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._n = int(m.n)
         self._ws_start = np.asarray(m.ws_start, dtype=np.int64)
         self._ws_width = np.asarray(m.ws_width, dtype=np.int64)
-        # the extended grasp map, transposed, as a view of every run of P contacts:
-        # runs[c, i] = "contact c against contacts i .. i+P-1", GaitModel.action_mask's
-        # regrasp rule (thesis 4.2), gathered for a batch of states in one call
-        rows = np.ascontiguousarray(m.grasp_map.extended().T)
-        self._runs = np.lib.stride_tricks.sliding_window_view(rows, self._P, axis=1)
+        self._runs = _grasp_map_runs(m, self._P)  # the mask's regrasp rule, batched
         # the same runs for c, i < n as one contiguous (n n, P) table, where it is small:
         # a row gather from it (np.take) is several times faster than from the view
         n2P = self._n * self._n * self._P
@@ -281,10 +277,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._k_tables()
         self._win_back = env._win_back
         self._windows = _window_views(env._pooled, env._stride, self.config.map_window_cells)
-        # map_lines: the grasp map's rows tiled twice, every run of n as a view, so that a
-        # held contact's line at angle k is row c, column (-k) mod n (the single env's rule)
-        self._lines = (None if env._line_src is None else
-                       np.lib.stride_tricks.sliding_window_view(env._line_src, self._n, axis=1))
+        self._lines = _line_views(env._line_src, self._n)  # map_lines
         # to_go_weight: the exact optimum's regrasps to go (the single env's table; looked
         # up one regrasp at a time, so this opt-in reward costs speed)
         self._to_go = env._to_go
@@ -427,13 +420,9 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             if sub.model is self._row_model[i]:
                 continue
             self._row_model[i] = sub.model
-            rows = np.ascontiguousarray(sub.model.grasp_map.extended().T)
-            runs = np.lib.stride_tricks.sliding_window_view(rows, P, axis=1)
-            self._row_runs[i] = runs[:n, :n].reshape(n * n, P)
+            self._row_runs[i] = _grasp_map_runs(sub.model, P)[:n, :n].reshape(n * n, P)
             self._row_windows[i] = _window_views(sub._pooled, sub._stride, C)
-            self._row_lines[i] = (None if sub._line_src is None else
-                                  np.lib.stride_tricks.sliding_window_view(sub._line_src, n,
-                                                                           axis=1))
+            self._row_lines[i] = _line_views(sub._line_src, n)
 
     def _model_of(self, i: int) -> Any:
         """The gait model of sub-env ``i``."""
@@ -862,6 +851,22 @@ def _copy_env(env: GraspGaitEnv) -> GraspGaitEnv:
     sub._np_random = None
     sub._np_random_seed = None
     return sub
+
+
+def _grasp_map_runs(model: Any, P: int) -> NDArray[np.bool_]:
+    """The extended grasp map, transposed, as a view of every run of ``P`` contacts:
+    ``runs[c, i]`` is "contact ``c`` against contacts ``i .. i+P-1``",
+    ``GaitModel.action_mask``'s regrasp rule (thesis 4.2), for a batch of states at once."""
+    rows = np.ascontiguousarray(model.grasp_map.extended().T)
+    return np.lib.stride_tricks.sliding_window_view(rows, P, axis=1)
+
+
+def _line_views(line_src: NDArray[np.float32] | None, n: int) -> NDArray[np.float32] | None:
+    """``map_lines``: every run of ``n`` of the grasp map's rows tiled twice (the single
+    env's ``_line_src``), so that a held contact's line at angle ``k`` is row ``c``,
+    column ``(-k) mod n``; None without ``map_lines``."""
+    return (None if line_src is None
+            else np.lib.stride_tricks.sliding_window_view(line_src, n, axis=1))
 
 
 def _window_views(pooled: NDArray[np.float32], s: int, cells: int) -> NDArray[np.float32]:
