@@ -55,6 +55,7 @@ test-all: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/lint-imports
 
 perf: $(STAMP)
 	$(BIN)/graspgait perf

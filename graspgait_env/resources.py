@@ -1,10 +1,10 @@
 """Bundled data files: objects, hands and simulation configs shipped with the package.
 
-The repository's top-level ``configs/`` folder is their source; the build maps it to the
-package ``graspgait_env.configs`` (``pyproject.toml``, ``[tool.setuptools.package-dir]``),
-so a wheel or a non-editable install carries every YAML file, and an editable install
-reads them from the checkout. Code never builds a path from ``__file__`` to reach them:
-it asks this module, which goes through :mod:`importlib.resources`.
+They live in the package folder ``graspgait_env/configs/`` (the package
+``graspgait_env.configs``), so a wheel or a non-editable install carries every YAML file,
+and an editable install reads them from the checkout. Code never builds a path from
+``__file__`` to reach them: it asks this module, which goes through
+:mod:`importlib.resources`.
 
 Layout (``KIND/NAME.yaml``): ``objects/`` (object files), ``hands/`` (hand files),
 ``sim/`` (simulation configs), ``train/`` (training configs of ``graspgait train``),

@@ -5,7 +5,7 @@ the griffe extension (``griffe_roles.py``, which turns the Sphinx roles of the d
 ``:class:`~graspgait_env.gait.GaitModel```, into mkdocstrings cross-references).
 
 The public API is the ``__all__`` of each public module (no part of its dotted name
-starts with ``_``) of ``graspgait_env``, including the folders that install beneath it
+starts with ``_``) of ``graspgait_env``, its subpackages included
 (``graspgait_env.agents``, ``graspgait_env.baselines``, ``graspgait_env.configs``).
 A module's page documents the names of its ``__all__`` that it defines; the names it
 re-exports link to the module that defines them.
@@ -19,7 +19,6 @@ import importlib
 import inspect
 import pkgutil
 import re
-import shutil
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -27,48 +26,15 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = "graspgait_env"
-# the extra folders that install beneath the package (pyproject [tool.setuptools.package-dir])
-MAPPED = {"graspgait_env.agents": "agents", "graspgait_env.baselines": "baselines",
-          "graspgait_env.configs": "configs"}
-
-
-def source_layout(dest: Path) -> Path:
-    """Lay the sources out under ``dest`` as the wheel installs them, with symbolic links
-    (``dest/graspgait_env/agents`` -> ``agents/``, ...), for griffe, which finds a
-    package's modules by walking its folder. Idempotent; returns ``dest``."""
-    pkg = dest / PACKAGE
-    want = {p.name: p for p in (ROOT / PACKAGE).iterdir() if p.name != "__pycache__"}
-    for name, folder in MAPPED.items():
-        want[name.rsplit(".", 1)[1]] = ROOT / folder
-    ok = pkg.is_dir() and {p.name: p.resolve() for p in pkg.iterdir()} == {
-        k: v.resolve() for k, v in want.items()}
-    if ok:
-        return dest
-    tmp = dest / f".{PACKAGE}.{id(want)}.tmp"
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
-    for name, target in want.items():
-        (tmp / name).symlink_to(target)
-    shutil.rmtree(pkg, ignore_errors=True)
-    try:
-        tmp.rename(pkg)
-    except OSError:  # another build laid it out at the same moment
-        shutil.rmtree(tmp, ignore_errors=True)
-    return dest
 
 
 @functools.lru_cache(maxsize=1)
 def public_modules() -> tuple[str, ...]:
-    """Every public module of the package, the mapped folders included, sorted."""
+    """Every public module of the package, its subpackages included, sorted."""
     out = {PACKAGE}
-    roots = [PACKAGE, *MAPPED]
-    for root in roots:
-        mod = importlib.import_module(root)
-        out.add(root)
-        for info in pkgutil.walk_packages(mod.__path__, root + "."):
-            parts = info.name.split(".")
-            if any(p.startswith("_") for p in parts):
-                continue
+    mod = importlib.import_module(PACKAGE)
+    for info in pkgutil.walk_packages(mod.__path__, PACKAGE + "."):
+        if not any(p.startswith("_") for p in info.name.split(".")):
             out.add(info.name)
     return tuple(sorted(out))
 

@@ -36,9 +36,6 @@ import apiref  # noqa: E402
 
 log = logging.getLogger("mkdocs.plugins.graspgait_pages")
 ROOT = apiref.ROOT
-SOURCE_LAYOUT = ROOT / "build" / "docs_src"  # mkdocs.yml: mkdocstrings' python paths
-# laid out when mkdocs loads this hook, before mkdocstrings sets up its search paths
-apiref.source_layout(SOURCE_LAYOUT)
 
 # Gymnasium's sections of an env page, in order; other sections of a docstring (Info,
 # Pickling) come after Episode End

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from graspgait_env.agents.bench import SHIPPED_AGENTS
 from graspgait_env.agents.card import (
     describe_shipped,
@@ -23,7 +24,6 @@ from graspgait_env.agents.config import TrainConfig
 from graspgait_env.agents.envs import make_env
 from graspgait_env.agents.evaluate import evaluate
 from graspgait_env.agents.legacy import legacy_module_names, upgrade_card, upgrade_import_path
-
 from graspgait_env.errors import GraspGaitInputError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -38,7 +38,7 @@ KITE = ("name: kite\ntype: polygon\n"
 def test_every_shipped_agent_is_installed_with_both_cards():
     """A missing model or card fails here (it is not skipped anywhere)."""
     assert shipped_agents() == sorted(SHIPPED_AGENTS)
-    repo = sorted(p.stem for p in (ROOT / "agents" / "models").glob("*.zip"))
+    repo = sorted(p.stem for p in (ROOT / "graspgait_env" / "agents" / "models").glob("*.zip"))
     assert repo == sorted(SHIPPED_AGENTS)
     for name in SHIPPED_AGENTS:
         for suffix in (".zip", ".json", ".md"):

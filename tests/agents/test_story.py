@@ -7,15 +7,16 @@ import json
 from pathlib import Path
 
 import pytest
-from graspgait_env.agents.story import GAITS, learned_gait, story_table, tell_story
 
+from graspgait_env.agents.story import GAITS, learned_gait, story_table, tell_story
 from graspgait_env.cli import main
 from graspgait_env.plan import Plan, validate_plan
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.registry import default_start
 from graspgait_env.planners.rule_based import rule_based
 
-ELLIPSE = Path(__file__).resolve().parents[2] / "agents" / "models" / "ellipse.zip"
+ELLIPSE = (Path(__file__).resolve().parents[2] / "graspgait_env" / "agents" / "models"
+           / "ellipse.zip")
 
 
 @pytest.fixture(scope="module")

@@ -20,12 +20,13 @@ from email.parser import Parser
 from pathlib import Path
 
 import pytest
-from graspgait_env.agents.bench import SHIPPED_AGENTS
 
 import graspgait_env
+from graspgait_env.agents.bench import SHIPPED_AGENTS
 from graspgait_env.envs.registration import ENV_IDS
 
 ROOT = Path(__file__).resolve().parents[2]
+CONFIGS = ROOT / "graspgait_env" / "configs"
 EXTRA_MODULES = ("torch", "stable_baselines3", "sb3_contrib", "tensorboard", "ray", "rl_zoo3",
                  "moviepy", "imageio_ffmpeg")
 
@@ -72,7 +73,7 @@ def test_wheel_has_one_top_level_import_name(wheel: Path) -> None:
 
 def test_wheel_carries_every_config_asset_and_shipped_agent(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
-    sources = sorted(p.relative_to(ROOT / "configs") for p in (ROOT / "configs").rglob("*.y*ml"))
+    sources = sorted(p.relative_to(CONFIGS) for p in CONFIGS.rglob("*.y*ml"))
     assert sources, "no configs found in the checkout"
     missing = [str(p) for p in sources if f"graspgait_env/configs/{p.as_posix()}" not in names]
     assert not missing, f"configs missing from the wheel: {missing}"
@@ -190,7 +191,7 @@ def test_a_new_users_first_commands_run_from_an_empty_folder(site: Path, tmp_pat
     if argv[0] == "bench":
         assert "| pentagon |" in out and "pentagon" in out.split("agent")[-1]
     if argv[:1] == ["config"]:
-        assert out == (ROOT / "configs" / "sim" / "default.yaml").read_text()
+        assert out == (CONFIGS / "sim" / "default.yaml").read_text()
     if "--list" in argv:
         for name in SHIPPED_AGENTS:
             assert name in out

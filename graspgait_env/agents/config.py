@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from graspgait_env.agents.legacy import upgrade_import_path
 
+from graspgait_env.agents.legacy import upgrade_import_path
 from graspgait_env.envs.config import check_count, check_number
 from graspgait_env.envs.registration import ENV_IDS
 from graspgait_env.errors import GraspGaitInputError

@@ -30,7 +30,6 @@ from pathlib import Path
 from typing import Any
 
 from graspgait_env.agents.config import TrainConfig
-
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["SeedOutcome", "evaluate_on_ray", "train_seeds"]
@@ -112,9 +111,10 @@ def train_seeds(config: TrainConfig, seeds: Sequence[int], *, use_ray: bool = Fa
 def _tune_seeds(config: TrainConfig, seeds: list[int], address: str | None,
                 progress: bool) -> list[SeedOutcome]:
     """One Ray Tune trial per seed; outcomes in seed order."""
-    from graspgait_env.baselines.scale_out import ray_session
     from ray import tune
     from tqdm.auto import tqdm
+
+    from graspgait_env.baselines.scale_out import ray_session
 
     def trainable(params: dict[str, Any]) -> None:
         out = _run_one(config, params["seed"])
@@ -206,7 +206,6 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
 
     from graspgait_env.agents.evaluate import evaluate, summarize_episodes
     from graspgait_env.baselines.scale_out import ray_session, run_tasks
-
     from graspgait_env.envs.config import check_count
 
     episodes = check_count("episodes", episodes, 1, 100)

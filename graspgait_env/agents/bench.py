@@ -40,6 +40,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from tqdm.auto import tqdm
+
 from graspgait_env.agents.card import (
     load_agent,
     resolve_model,
@@ -48,10 +50,8 @@ from graspgait_env.agents.card import (
 )
 from graspgait_env.agents.envs import env_kwargs_for, make_env
 from graspgait_env.agents.evaluate import agent_predictor, play_episode
-from graspgait_env.baselines.bench import THESIS_OBJECTS, BenchCase, bench_starts
-from tqdm.auto import tqdm
-
 from graspgait_env.atomic import atomic_write
+from graspgait_env.baselines.bench import THESIS_OBJECTS, BenchCase, bench_starts
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel
 

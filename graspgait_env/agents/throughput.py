@@ -28,11 +28,11 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+
 from graspgait_env.agents.config import load_train_config
 from graspgait_env.agents.evaluate import EVAL_SEED
 from graspgait_env.agents.seeding import seed_everything, set_torch_threads
 from graspgait_env.agents.train import build_model, make_vec_env_for
-
 from graspgait_env.envs.vector_env import GraspGaitVectorEnv
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.timing import BenchRow, register

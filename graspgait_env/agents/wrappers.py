@@ -217,7 +217,6 @@ def rule_based_starts(model: Any, turn_deg: float) -> list[Any]:
     qualify) and cached.
     """
     from graspgait_env.agents.evaluate import ReferenceGaits
-
     from graspgait_env.planners.rule_based import rule_based
 
     key = (ReferenceGaits().model_key(model), model.turn_steps(turn_deg))

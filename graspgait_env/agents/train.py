@@ -39,6 +39,8 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from tqdm.auto import tqdm
+
 from graspgait_env.agents.card import load_agent, read_card, resolve_model, save_agent
 from graspgait_env.agents.config import TrainConfig
 from graspgait_env.agents.envs import contact_model_of, import_object, make_env
@@ -54,8 +56,6 @@ from graspgait_env.agents.evaluate import (
     summarize_episodes,
 )
 from graspgait_env.agents.seeding import seed_everything, set_torch_threads
-from tqdm.auto import tqdm
-
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.extras import require_extra

@@ -35,8 +35,8 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from graspgait_env.agents.legacy import legacy_module_names, upgrade_card
 
+from graspgait_env.agents.legacy import legacy_module_names, upgrade_card
 from graspgait_env.atomic import atomic_write, write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.extras import require_extra

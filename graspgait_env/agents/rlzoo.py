@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from stable_baselines3.common.callbacks import BaseCallback
+
 from graspgait_env.agents.config import default_torch_threads
 from graspgait_env.agents.seeding import set_torch_threads
-from stable_baselines3.common.callbacks import BaseCallback
 
 __all__ = ["TorchThreadsCallback"]
 

@@ -45,12 +45,12 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from tqdm.auto import tqdm
+
 from graspgait_env.agents.audit import audit_moves, summarize_audits
 from graspgait_env.agents.card import load_agent
 from graspgait_env.agents.envs import contact_model_of, env_kwargs_for, make_env
 from graspgait_env.agents.seeding import seed_everything
-from tqdm.auto import tqdm
-
 from graspgait_env.atomic import json_ready, write_text_atomic
 from graspgait_env.envs.config import check_count, check_mu, check_object
 from graspgait_env.envs.registration import ENV_IDS

@@ -25,10 +25,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
 from graspgait_env.agents.card import load_agent
 from graspgait_env.agents.envs import env_kwargs_for, make_env
 from graspgait_env.agents.evaluate import agent_predictor
-
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.plan import Plan, plan_from_states
