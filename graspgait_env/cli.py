@@ -883,7 +883,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     else:
         result = evaluate(args.model, env_id=args.env, object=args.object, mu=mu,
                           episodes=args.episodes, seed=args.seed, env_overrides=env_set,
-                          progress=not args.quiet, audit=args.audit)
+                          progress=not args.quiet, audit=args.audit,
+                          batched=not args.one_by_one)
     print(format_evaluation(result))
     if args.json:
         _write_output("--json", args.json, lambda: write_evaluation(result, args.json))
@@ -925,6 +926,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--audit", action="store_true",
                    help="price every move against the optimum: where the regrasps beyond "
                    "it go (idle regrasps, losing regrasps, losing rotations)")
+    p.add_argument("--one-by-one", action="store_true",
+                   help="play the episodes one by one in the single env, not side by side "
+                   "in the batched one (same records; for timing the two)")
     _add_ray_option(p, "split the episodes over Ray tasks; same result as serially")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_evaluate)

@@ -23,6 +23,7 @@ from typing import Any
 
 import yaml
 
+from graspgait_env.agents.imitation import Imitation
 from graspgait_env.agents.legacy import upgrade_import_path
 from graspgait_env.envs.config import check_count, check_number
 from graspgait_env.envs.registration import ENV_IDS
@@ -237,6 +238,11 @@ class TrainConfig:
     (a curriculum, a fine-tune). The model must have this config's algorithm, observation
     and action spaces and network. The card records its steps and wall time
     (``init``), so the training a model took is stated in full."""
+    imitation: Imitation | None = None
+    """DAgger from the exact optimum before PPO (:class:`~graspgait_env.agents.imitation.
+    Imitation`: ``{iterations, labels, epochs, batch_size, learning_rate}``), or None (PPO
+    from the start). Needs ``algo: maskable_ppo`` and ``vec_env: dummy`` or ``subproc``;
+    the card records its labels, env steps and wall time (``imitation``)."""
     init_logit_scale: float = 1.0
     """With ``init_model``: multiply the policy head's weights and bias (the action
     logits) by this factor in (0, 1] before training. Below 1 the run starts from a
@@ -329,6 +335,13 @@ class TrainConfig:
             put("init_model", str(self.init_model))
         put("init_logit_scale", check_number("init_logit_scale", self.init_logit_scale, 0.2,
                                              minimum=0.0, maximum=1.0, strict=True))
+        if self.imitation is not None:
+            put("imitation", Imitation.from_mapping(self.imitation))
+            if self.algo != "maskable_ppo" or self.vec_env == "batched":
+                raise GraspGaitInputError(
+                    f"imitation with algo={self.algo!r}, vec_env={self.vec_env!r}: imitation "
+                    "trains a maskable policy on envs that give optimal_moves(); set algo: "
+                    "maskable_ppo and vec_env: dummy (or subproc), or imitation: null")
         if self.init_logit_scale != 1.0 and self.init_model is None:
             raise GraspGaitInputError(
                 f"init_logit_scale={self.init_logit_scale}: scales the weights of "

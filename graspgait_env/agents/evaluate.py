@@ -479,7 +479,8 @@ def agent_batch_predictor(model: Any) -> Callable[[np.ndarray, np.ndarray], np.n
 def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
              object: Any = None, mu: float | None = None, episodes: int = 100, seed: int = 0,
              deterministic: bool = True, env_overrides: Mapping[str, Any] | None = None,
-             progress: bool = False, audit: bool = False) -> dict[str, Any]:
+             progress: bool = False, audit: bool = False,
+             batched: bool = True) -> dict[str, Any]:
     """Evaluate a saved agent (``model.zip``) and compare it with the optimum and the rules.
 
     Parameters
@@ -516,6 +517,11 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         solvable starts (their ``excess_regrasps`` is the agent's regrasps there less
         the optimum's). The episodes are then played one by one (the same records as
         side by side, tested; slower).
+    batched
+        Play deterministic episodes side by side in the batched env where it applies
+        (:func:`batched_eval_env`; one policy call per step for up to
+        :data:`EVAL_BATCH` episodes); False plays them one by one in the single env.
+        The records are the same either way (tested); only the wall time differs.
 
     Returns
     -------
@@ -559,7 +565,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
                 "observation_mode)")
         venv = (batched_eval_env(env_id, kwargs, card.get("wrappers") or (),
                                  min(episodes, EVAL_BATCH))
-                if deterministic and not audit else None)
+                if deterministic and not audit and batched else None)
         if venv is not None:  # the same episodes side by side: one policy call per step
             try:
                 records = run_episodes_batched(agent_batch_predictor(model), venv, episodes,

@@ -55,6 +55,7 @@ from graspgait_env.agents.evaluate import (
     run_episodes_batched,
     summarize_episodes,
 )
+from graspgait_env.agents.imitation import imitate
 from graspgait_env.agents.seeding import seed_everything, set_torch_threads
 from graspgait_env.atomic import write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
@@ -457,6 +458,13 @@ def train(config: TrainConfig, *, run_dir: str | os.PathLike[str] | None = None,
     if init is not None:
         card_base["init"] = init
     t0 = time.perf_counter()
+    if config.imitation is not None and ckpt is None:  # DAgger first (agents/imitation)
+        try:
+            card_base["imitation"] = imitate(model, env, config.imitation, seed=config.seed,
+                                             progress=progress)
+        except BaseException:
+            env.close()
+            raise
     cb = _callbacks(config, run, card_base, progress, wall_before, t0)
     try:
         model.learn(total_timesteps=config.total_timesteps - int(model.num_timesteps),

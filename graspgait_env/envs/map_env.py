@@ -42,6 +42,7 @@ from graspgait_env.envs.observation import (
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import REGRASP, ROTATE, GaitModel, GaitState
 from graspgait_env.planners.exact import RegraspsToGo
+from graspgait_env.planners.optimal_moves import OptimalMoves
 from graspgait_env.planners.reach import RegraspReach
 from graspgait_env.shapes import Shape
 from graspgait_env.workspace import Hand
@@ -581,6 +582,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                                     cfg.regrasp_lookahead - 1)
                        if cfg.regrasp_lookahead else None)
         self._gained = 0  # regrasps gained towards the goal by the move rewarded (_reward)
+        self._optimal: OptimalMoves | None = None  # built by optimal_moves() when asked
 
     def _make_spaces(self) -> None:
         A, C = self._A, self.config.map_window_cells
@@ -646,6 +648,29 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         if mask is None:
             raise self._reset_needed("action_masks")
         return mask
+
+    def optimal_moves(self) -> NDArray[np.bool_]:
+        """The legal moves of the present state that begin a fewest-regrasp gait (the
+        exact optimum read per state, :class:`~graspgait_env.planners.optimal_moves.
+        OptimalMoves`), as a mask over the actions: the teacher of imitation learning.
+
+        The planner's set less what this env forbids (``forbid_reversal``,
+        ``forbid_revisit``), so it can be empty where the episode's own rules block the
+        optimum, and is empty when no gait reaches the turn from here. The tables are
+        built for each model on the first call (the regrasps-to-go table is shared with
+        ``to_go_weight``'s); the observation and the reward do not change.
+
+        Raises
+        ------
+        ResetNeededError
+            Before the first ``reset()``.
+        """
+        mask = self.action_masks()
+        if self._optimal is None or self._optimal.model is not self.model:
+            cfg = self.config
+            self._optimal = OptimalMoves(self.model, cfg.turn_deg, cfg.max_backward_deg,
+                                         to_go=self._to_go)
+        return self._optimal(GaitState(self._k, self._c)) & mask
 
     def _set_state(self, s: GaitState) -> None:
         self._k = k = int(s.k)
