@@ -81,6 +81,7 @@ class Imitation:
         return cls(**dict(value))
 
     def to_dict(self) -> dict[str, Any]:
+        """The fields as a plain mapping (the YAML block, the card's ``imitation.config``)."""
         return asdict(self)
 
 
