@@ -68,7 +68,6 @@ def _good(r: dict | None) -> bool:
 
 def main() -> None:
     from graspgait_env.baselines.scale_out import campaign
-
     from graspgait_env.plan import Plan
     from graspgait_env.sim.config import load_sim_config
 

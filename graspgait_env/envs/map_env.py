@@ -39,6 +39,17 @@ from graspgait_env.envs.observation import (
     ObservationLayout,
     ObservationParts,
 )
+from graspgait_env.envs.rows import (
+    drop_reversals,
+    k_tables,
+    line_views,
+    regrasps_gained,
+    regrasps_opened,
+    reward_terms,
+    window_at,
+    window_views,
+    write_lines,
+)
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import REGRASP, ROTATE, GaitModel, GaitState
 from graspgait_env.planners.exact import RegraspsToGo
@@ -552,6 +563,12 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 f"least {self._step_deg:g} degrees")
         self._back = model.turn_steps(cfg.max_backward_deg)
         self._turn_coef = cfg.alpha * self._step_deg / cfg.turn_scale
+        # turn_deg, max_backward_deg: the per-angle tables (rows.k_tables, shared with the
+        # batched env), and their columns as lists for this env's scalar step
+        kt = self._kt = k_tables(self._sign, self._Kabs, self._back, int(model.R), n)
+        self._k_reached = kt.reached.tolist()
+        self._k_success = kt.success.tolist()
+        self._k_ends = kt.ends.tolist()
         # GaitModel.decode of every rotation (a rotation's delta does not depend on the
         # state, so it is decoded once per model; 0: the action is a regrasp)
         probe = GaitState(0, (0, 0, -1))
@@ -564,15 +581,18 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         s = cfg.window_stride()
         self._stride = s
         self._win_back = s * (cells // 2) + s // 2
-        self._win_len = s * cells
         self._pooled = _pooled_map(model.stable, s)
-        # the map's rows tiled twice: a held contact's line at angle k is one slice
+        self._windows = window_views(self._pooled, s, cells)  # rows.window_at reads it
+        # map_lines: the map's rows tiled twice, a held contact's line at angle k one
+        # slice of it (rows.write_lines reads the views)
         self._line_src = (np.tile(model.stable, (1, 2)).astype(np.float32)
                           if cfg.map_lines else None)
+        self._lines = line_views(self._line_src, n)
         # rotation_lookahead: which rotations open a regrasp (thesis 4.2, 5.2), per model
         self._openings = regrasp_openings(model) if cfg.rotation_lookahead else None
         self._rot_delta = np.asarray(self._delta[:2 * model.R], dtype=np.int64)
         self._ws_start = [int(x) for x in model.ws_start]
+        self._ws_start_a = np.asarray(self._ws_start, dtype=np.int64)
         self._starts: list[GaitState] | None = None
         # regrasps to go from every state (the exact optimum's count; only when rewarded)
         self._to_go = (RegraspsToGo(model, cfg.turn_deg, cfg.max_backward_deg)
@@ -608,10 +628,16 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                                   else self._parts.space)
         self.action_space = spaces.Discrete(A)
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
+        self._make_views()
+
+    def _make_views(self) -> None:
+        """Views of the box vector ``_obs`` that the step writes into (the rows
+        functions take batches: the lines and the look-ahead as rows of one)."""
+        C = self.config.map_window_cells
         self._win_view = self._obs[self.layout.window].reshape(C, C)
         self._mask_view = self._obs[self.layout.mask]
-        self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
-        self._look_view = self._obs[self.layout.lookahead]
+        self._line_view = self._obs[None, self.layout.lines].reshape(1, -1, self._n)
+        self._look_view = self._obs[None, self.layout.lookahead]
         self._reach_view = self._obs[self.layout.reach]
 
     def _check_model_fits(self, model: GaitModel) -> None:
@@ -688,12 +714,8 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         function; a fresh array each call), less, with ``forbid_reversal``, the rotations
         against the last move when it was a rotation."""
         mask = self.model.action_mask(GaitState(self._k, self._c))
-        if self._last_turn and self.config.forbid_reversal:
-            R = self.model.R
-            if self._last_turn > 0:
-                mask[R:2 * R] = False  # clockwise after counter-clockwise
-            else:
-                mask[:R] = False
+        if self._last_turn and self.config.forbid_reversal:  # a batch of one
+            drop_reversals(mask[None], np.array([self._last_turn]), int(self.model.R))
         if self._visited is not None:
             drop_revisits(self.model, mask, self._k, self._c, *self._visited)
         return mask
@@ -712,33 +734,26 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 o[_POS + f] = -1.0
                 o[_PHI + 2 * f] = 0.0
                 o[_PHI + 2 * f + 1] = 0.0
-        n, wb, s, L = self._n, self._win_back, self._stride, self._win_len
-        i0 = (c[self._f] - wb) % n
-        j0 = (c[self._g] - wb) % n
-        self._win_view[...] = self._pooled[i0:i0 + L:s, j0:j0 + L:s]
+        n, wb = self._n, self._win_back
+        self._win_view[...] = window_at(self._windows, (c[self._f] - wb) % n,
+                                        (c[self._g] - wb) % n)
 
     def _write_motion(self) -> None:
         """Observation entries that change with every move."""
         o, f, g, k = self._obs, self._f, self._g, self._k
         o[_POS + f] = self._p[f] * self._inv_w[f]
         o[_POS + g] = self._p[g] * self._inv_w[g]
-        km = k % self._n
-        o[_THETA] = self._cos[km]
-        o[_THETA + 1] = self._sin[km]
-        if self._line_src is not None:  # thesis 4.3: the regrasps keeping f or g
-            m = -k % self._n  # F angle j touches contact (j - k) mod n
-            self._line_view[0] = self._line_src[self._c[f], m:m + self._n]
-            self._line_view[1] = self._line_src[self._c[g], m:m + self._n]
-        t = self._sign * k
-        o[_ACHIEVED] = t / self._Kabs
-        o[_TO_GO] = max(0, self._Kabs - t) / self._Kabs
+        # cos theta, sin theta, turn achieved and to go: one row of the k tables
+        o[_THETA:_TO_GO + 1] = self._kt.head[k - self._kt.lo]
         self._mask_view[...] = self._mask
-        if self._openings is not None:  # thesis 4.2, 5.2: the regrasps a rotation opens
-            # after rotating by d the free finger's workspace starts at contact s_h - k - d
-            i = (self._ws_start[self._h] - k - self._rot_delta) % self._n
-            opens = self._openings[self._h]
-            self._look_view[...] = ((opens[self._c[f], i] | opens[self._c[g], i])
-                                    & self._mask[:self._rot_delta.size])
+        if self._lines is not None or self._openings is not None:  # a batch of one
+            cf, cg, kk = (np.array([x]) for x in (self._c[f], self._c[g], k))
+            if self._lines is not None:  # map_lines (thesis 4.3)
+                write_lines(self._line_view, self._lines, cf, cg, kk)
+            if self._openings is not None:  # rotation_lookahead (thesis 4.2, 5.2)
+                self._look_view[...] = regrasps_opened(
+                    self._openings, np.array([self._h]), cf, cg, kk, self._ws_start_a,
+                    self._rot_delta, self._n, self._mask[None, :self._rot_delta.size])
         if self._reach is not None:
             self._reach_view[...] = self._reach.move_shortfalls(
                 self._h, f, g, self._p[f], self._p[g], k, self._mask, self._rot_delta)
@@ -783,23 +798,15 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
             ``terms`` in :data:`REWARD_TERMS` order; ``reward`` is their sum in that
             order, so ``reward == sum(terms.values())`` exactly.
         """
-        cfg = self.config
-        K = self._Kabs
-        t0, t1 = self._sign * k0, self._sign * k1
-        # thesis 5.4: alpha * theta, the turn towards the goal, overshoot earning nothing
-        turn = self._turn_coef * ((t1 if t1 < K else K) - (t0 if t0 < K else K))
-        regrasp = -cfg.beta if move is REGRASP else 0.0  # thesis 5.4: - beta * regrasps
+        lo, reached = self._kt.lo, self._k_reached
+        gained = 0
         if move is REGRASP and self._to_go is not None:  # priced against the optimum
-            regrasp += cfg.to_go_weight * self._gained
+            gained = self._gained
             self._gained = 0  # a regrasp whose outcome step() did not set gains nothing
-        rotation = -cfg.gamma if move is ROTATE else 0.0  # thesis 5.4: - gamma * rotations
-        illegal = -cfg.illegal_penalty if move is None else 0.0
-        success = dead_end = 0.0
-        if ends:
-            if is_success:
-                success = cfg.success_bonus
-            else:
-                dead_end = -cfg.dead_end_penalty
+        # thesis 5.4 and the episode-end terms: the one implementation (rows.reward_terms)
+        turn, regrasp, rotation, success, dead_end, illegal = reward_terms(
+            self.config, self._turn_coef, reached[k0 - lo], reached[k1 - lo],
+            move is REGRASP, move is ROTATE, move is None, ends, is_success, gained)
         reward = turn + regrasp + rotation + success + dead_end + illegal
         return reward, {"turn": turn, "regrasp": regrasp, "rotation": rotation,
                         "success": success, "dead_end": dead_end, "illegal": illegal}
@@ -952,10 +959,10 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
                 self._regrasps += 1
                 self._last_turn = 0
                 self._write_grasp()
-                if self._to_go is not None:
-                    before, self._togo_now = self._togo_now, self._to_go(GaitState(k0, self._c))
-                    # both -1 when no gait exists from here: nothing gained
-                    self._gained = before - self._togo_now
+                if self._to_go is not None:  # to_go_weight, a batch of one
+                    gained, now = regrasps_gained([self._to_go], np.array([self._togo_now]),
+                                                  np.array([k0]), np.array([self._c]))
+                    self._gained, self._togo_now = int(gained[0]), int(now[0])
             if self._visited is not None:
                 visit_state(self._visited, self._k, self._c)
             self._mask = self._compute_mask()
@@ -965,9 +972,9 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
         else:
             move = None
             self._mask = self._mask.copy()  # every info gets its own array
-        t1 = self._sign * self._k
-        is_success = t1 >= self._Kabs
-        terminated = is_success or t1 < -self._back or not self._mask.any()
+        ki = self._k - self._kt.lo  # turn_deg, max_backward_deg: the k tables
+        is_success = self._k_success[ki]
+        terminated = self._k_ends[ki] or not self._mask.any()
         reward, terms = self._reward(k0, self._k, move, terminated and not self._terminal,
                                      is_success)
         self._terminal = terminated
@@ -1028,12 +1035,7 @@ class GraspGaitEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     def __setstate__(self, d: dict[str, Any]) -> None:
         self.__dict__.update(d)
-        C = self.config.map_window_cells
-        self._win_view = self._obs[self.layout.window].reshape(C, C)
-        self._mask_view = self._obs[self.layout.mask]
-        self._line_view = self._obs[self.layout.lines].reshape(-1, self._n)
-        self._look_view = self._obs[self.layout.lookahead]
-        self._reach_view = self._obs[self.layout.reach]
+        self._make_views()
 
 
 def _config_property(name: str) -> property:

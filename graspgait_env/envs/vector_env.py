@@ -40,6 +40,15 @@ from graspgait_env.envs.map_env import (
 )
 from graspgait_env.envs.observation import _HEADER, _HELD, _PHI, _POS, _THETA, _TO_GO
 from graspgait_env.envs.registration import MAX_EPISODE_STEPS
+from graspgait_env.envs.rows import (
+    drop_reversals,
+    grasp_map_runs,
+    regrasps_gained,
+    regrasps_opened,
+    reward_terms,
+    window_at,
+    write_lines,
+)
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.shapes import Shape
 
@@ -144,18 +153,15 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     - ``max_episode_steps``: the time limit (steps per episode; None: none).
     - ``copy``: return fresh observation arrays (default) or the env's buffer.
 
-    Every field of today's config is implemented: ``map_lines`` adds the map lines to
-    each row, ``rotation_lookahead`` the rotation look-ahead, ``contact_model`` changes
-    the shared gait model, ``to_go_weight`` looks up the optimum's regrasps to go of
-    each sub-env that regrasps, one at a time (this opt-in reward slows the batched
-    step), ``regrasp_lookahead`` writes the reach look-ahead of every row in one call
-    of :meth:`RegraspReach.move_shortfalls_batch
-    <graspgait_env.planners.reach.RegraspReach.move_shortfalls_batch>`, the one
-    implementation that the single env calls for its one row, ``forbid_reversal`` and
-    ``forbid_revisit`` remove the same moves from the masks as the single env
-    (``forbid_revisit`` keeps each sub-env's visited states in a Python set and checks
-    them row by row, so it slows the batched step too). A
-    field added to the config later (:data:`SUPPORTED_FIELDS` does not list it) is
+    Every field of today's config is implemented, each by one function of
+    :mod:`graspgait_env.envs.rows` that the single env calls with its one row and this
+    env with its ``N`` (the table there): the reward weights, ``map_lines``,
+    ``rotation_lookahead``, ``regrasp_lookahead``, ``forbid_reversal`` and the rest.
+    ``to_go_weight`` looks up the optimum's regrasps to go of each sub-env that
+    regrasps, one at a time, and ``forbid_revisit`` keeps each sub-env's visited states
+    in a Python set and checks them row by row, so these two opt-in fields slow the
+    batched step. A field added to the config later (:data:`SUPPORTED_FIELDS` does not
+    list it) is
     accepted at its default and raises ``ValueError`` naming it otherwise.
     ``render_mode`` must be None: the batched env draws nothing (make a single env with
     ``render_mode="rgb_array"`` to watch one episode).
@@ -240,7 +246,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._n = int(m.n)
         self._ws_start = np.asarray(m.ws_start, dtype=np.int64)
         self._ws_width = np.asarray(m.ws_width, dtype=np.int64)
-        self._runs = _grasp_map_runs(m, self._P)  # the mask's regrasp rule, batched
+        self._runs = grasp_map_runs(m, self._P)  # the mask's regrasp rule, batched
         # the same runs for c, i < n as one contiguous (n n, P) table, where it is small:
         # a row gather from it (np.take) is several times faster than from the view
         n2P = self._n * self._n * self._P
@@ -274,10 +280,12 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         self._sign, self._Kabs, self._back = env._sign, env._Kabs, env._back
         self._turn_coef = env._turn_coef
         self._step_deg = env._step_deg
-        self._k_tables()
+        kt = env._kt  # turn_deg, max_backward_deg: the template's k tables (rows.k_tables)
+        self._k_lo, self._k_head, self._k_reached = kt.lo, kt.head, kt.reached
+        self._k_success, self._k_ends = kt.success, kt.ends
         self._win_back = env._win_back
-        self._windows = _window_views(env._pooled, env._stride, self.config.map_window_cells)
-        self._lines = _line_views(env._line_src, self._n)  # map_lines
+        self._windows = env._windows  # rows.window_views of the template's map
+        self._lines = env._lines  # map_lines: rows.line_views (None without)
         # to_go_weight: the exact optimum's regrasps to go (the single env's table; looked
         # up one regrasp at a time, so this opt-in reward costs speed)
         self._to_go = env._to_go
@@ -344,28 +352,6 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
             a, b = model.rotation_room(f, np.where(inside, pf, 0), g, np.where(inside, pg, 0))
             self._rot_index[f, g] = np.where(inside, a * (R + 1) + b, 0)
 
-    def _k_tables(self) -> None:
-        """What depends on the object angle ``k`` alone, per ``k``: the observation's
-        ``cos θ, sin θ``, turn achieved and turn to go (as the single env writes them),
-        ``min(σk, |K|)`` (the turn term's θ*, thesis 5.4), success and the wrong-way end.
-
-        An episode ends once ``σk >= |K|`` or ``σk < -B``, and one move turns at most
-        ``R`` steps, so ``k`` stays within ``|K| + B + R`` of 0; the tables span that.
-        """
-        sign, K, R, n = self._sign, self._Kabs, self._R, self._n
-        span = K + self._back + R + 1
-        self._k_lo = -span
-        k = np.arange(-span, span + 1, dtype=np.int64)
-        t = sign * k
-        head = np.empty((k.size, 4), dtype=np.float32)
-        head[:, :2] = self._theta_cs[k % n]
-        head[:, 2] = t / K
-        head[:, 3] = np.maximum(0, K - t) / K
-        self._k_head = head
-        self._k_reached = np.minimum(t, K)  # θ* in grid steps
-        self._k_success = t >= K
-        self._k_ends = self._k_success | (t < -self._back)
-
     # ------------------------------------------------------------------ state
     def action_masks(self) -> NDArray[np.bool_]:
         """Legal actions of every sub-env, ``(N, A)`` bool (sb3-contrib MaskablePPO
@@ -414,15 +400,15 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     def _refresh_rows(self, idx: Sequence[int]) -> None:
         """Per-row tables of sub-envs ``idx`` whose reset drew a new object: the runs of
         its grasp map (the mask's regrasp rule), its map-window views and map lines."""
-        n, P, C = self._n, self._P, self.config.map_window_cells
+        n, P = self._n, self._P
         for i in idx:
             sub = self._subs[i]
             if sub.model is self._row_model[i]:
                 continue
             self._row_model[i] = sub.model
-            self._row_runs[i] = _grasp_map_runs(sub.model, P)[:n, :n].reshape(n * n, P)
-            self._row_windows[i] = _window_views(sub._pooled, sub._stride, C)
-            self._row_lines[i] = _line_views(sub._line_src, n)
+            self._row_runs[i] = grasp_map_runs(sub.model, P)[:n, :n].reshape(n * n, P)
+            self._row_windows[i] = sub._windows
+            self._row_lines[i] = sub._lines
 
     def _model_of(self, i: int) -> Any:
         """The gait model of sub-env ``i``."""
@@ -595,8 +581,7 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         np.logical_and(run_g, valid, out=mask[:, b::2])
         np.logical_and(run_f, valid, out=mask[:, b + 1::2])
         if self._forbid_reversal:  # no rotation against the last move if it was one
-            mask[self._last_turn > 0, R:2 * R] = False
-            mask[self._last_turn < 0, :R] = False
+            drop_reversals(mask, self._last_turn, R)
         if self._visited is not None:  # the single env's rule, row by row
             for i, vis in enumerate(self._visited):
                 drop_revisits(self._model_of(i), mask[i], int(self._k[i]),
@@ -605,16 +590,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
     def _regrasps_gained(self, idx: NDArray[np.int64]) -> NDArray[np.int64]:
         """Fall in the optimum's regrasps to go of sub-envs ``idx`` (they just regrasped),
         as the single env counts it (-1 to -1, no gait before or after: 0)."""
-        from graspgait_env.gait import GaitState
-
-        before = self._togo_now[idx]
         to_go = ([self._subs[i]._to_go for i in idx.tolist()] if self._per_row_objects
                  else [self._to_go] * idx.size)
-        now = np.array([t(GaitState(int(k), tuple(int(x) for x in c)))
-                        for t, k, c in zip(to_go, self._k[idx], self._c[idx], strict=True)],
-                       dtype=np.int64)
-        self._togo_now[idx] = now
-        return before - now
+        gained, self._togo_now[idx] = regrasps_gained(to_go, self._togo_now[idx],
+                                                      self._k[idx], self._c[idx])
+        return gained
 
     def _write_window(self, idx: NDArray[np.int64]) -> None:
         """Grasp-map window rows of sub-envs ``idx`` (their grasp changed): the single
@@ -623,13 +603,11 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         i0 = (c.take(at + self._f.take(idx)) - self._win_back) % n
         j0 = (c.take(at + self._g.take(idx)) - self._win_back) % n
         if self._per_row_objects:  # each row its own map
-            s = self._row_windows[int(idx[0])].shape[0]
-            win = np.stack([self._row_windows[i][a % s, b % s, a // s, b // s]
+            win = np.stack([window_at(self._row_windows[i], a, b)
                             for i, a, b in zip(idx.tolist(), i0.tolist(), j0.tolist(),
                                                strict=True)])
         else:
-            s = self._windows.shape[0]
-            win = self._windows[i0 % s, j0 % s, i0 // s, j0 // s]
+            win = window_at(self._windows, i0, j0)
         self._obs[idx, self.layout.window] = win.reshape(idx.size, -1)
 
     def step(self, actions: Any) -> tuple[NDArray[np.float32], NDArray[np.float64],
@@ -690,30 +668,27 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         hd[:, _POS:_POS + 3] = np.where(p >= 0, p * self._inv_w, -1.0)
         ki = k - self._k_lo  # rows of the per-k tables
         hd[:, _THETA:_TO_GO + 1] = self._k_head.take(ki, axis=0)
-        if self._lines is not None:  # thesis 4.3: the regrasps keeping f or g
-            shift = -k % n
-            lines = o[:, self.layout.lines].reshape(N, 2, n)
+        if self._lines is not None or self._openings is not None:
             cf, cg = c[self._arN, self._f], c[self._arN, self._g]
+        if self._lines is not None:  # map_lines (thesis 4.3): rows.write_lines
+            lines = o[:, self.layout.lines].reshape(N, 2, n)
             if self._per_row_objects:  # each row its own map
-                for i, src in enumerate(self._row_lines):
-                    lines[i, 0] = src[cf[i], shift[i]]
-                    lines[i, 1] = src[cg[i], shift[i]]
+                for r, src in enumerate(self._row_lines):
+                    sl = slice(r, r + 1)
+                    write_lines(lines[sl], src, cf[sl], cg[sl], k[sl])
             else:
-                lines[:, 0] = self._lines[cf, shift]
-                lines[:, 1] = self._lines[cg, shift]
-        if self._openings is not None:  # thesis 4.2, 5.2: the regrasps a rotation opens
-            h = self._h[:, None]
-            i = (self._ws_start[h] - k[:, None] - self._rot_delta) % n
-            cf, cg = c[self._arN, self._f][:, None], c[self._arN, self._g][:, None]
+                write_lines(lines, self._lines, cf, cg, k)
+        if self._openings is not None:  # rotation_lookahead: rows.regrasps_opened
             if self._per_row_objects:  # each row its own table
-                opens = np.concatenate([
-                    self._subs[r]._openings[h[r], cf[r], i[r]]
-                    | self._subs[r]._openings[h[r], cg[r], i[r]] for r in range(N)])
-                opens = opens.reshape(N, -1)
+                for r in range(N):
+                    sl = slice(r, r + 1)
+                    o[sl, self.layout.lookahead] = regrasps_opened(
+                        self._subs[r]._openings, self._h[sl], cf[sl], cg[sl], k[sl],
+                        self._ws_start, self._rot_delta, n, mask[sl, :2 * R])
             else:
-                opens = self._openings[h, cf, i] | self._openings[h, cg, i]
-            np.logical_and(opens, mask[:, :2 * R], out=opens)
-            o[:, self.layout.lookahead] = opens
+                o[:, self.layout.lookahead] = regrasps_opened(
+                    self._openings, self._h, cf, cg, k, self._ws_start, self._rot_delta, n,
+                    mask[:, :2 * R])
         if self._reach is not None:  # the reach look-ahead, every row
             arN, f, g = self._arN, self._f, self._g
             pf, pg = p[arN, f], p[arN, g]
@@ -729,18 +704,19 @@ class GraspGaitVectorEnv(gym.vector.VectorEnv):
         # episode ends and reward (GraspGaitEnv._reward's table, term by term, same order)
         is_success = self._k_success[ki]
         terminated = live & (self._k_ends[ki] | ~mask.any(axis=1))
-        cfg = self.config
         reached = self._k_reached
-        turn = self._turn_coef * (reached[ki] - reached[ki - dk])  # thesis 5.4
-        if reset_idx.size:
-            turn[reset_idx] = 0.0  # a restarted sub-env earns nothing at this step
-        regrasp = np.where(rg, -cfg.beta, 0.0)  # thesis 5.4: - beta per regrasp
-        if self._to_go is not None and ri.size:  # + to_go_weight * regrasps gained
-            regrasp[ri] += cfg.to_go_weight * self._regrasps_gained(ri)
-        rotation = np.where(rot, -cfg.gamma, 0.0)  # thesis 5.4: - gamma per rotation
-        success = np.where(terminated & is_success, cfg.success_bonus, 0.0)
-        dead_end = np.where(terminated & ~is_success, -cfg.dead_end_penalty, 0.0)
-        illegal = np.where(live ^ legal, -cfg.illegal_penalty, 0.0)  # legal implies live
+        reached0 = reached[ki - dk]
+        if reset_idx.size:  # a restarted sub-env earns nothing at this step
+            reached0[reset_idx] = reached[ki[reset_idx]]
+        gained: Any = 0
+        if self._to_go is not None and ri.size:  # to_go_weight: regrasps gained
+            gained = np.zeros(N, dtype=np.int64)
+            gained[ri] = self._regrasps_gained(ri)
+        # thesis 5.4 and the episode-end terms: the one implementation (rows.reward_terms);
+        # illegal: live and not legal (legal implies live)
+        turn, regrasp, rotation, success, dead_end, illegal = reward_terms(
+            self.config, self._turn_coef, reached0, reached[ki], rg, rot, live ^ legal,
+            terminated, is_success, gained)
         reward = turn + regrasp + rotation + success + dead_end + illegal
         # the time limit (gymnasium's TimeLimit: truncated once elapsed >= the limit)
         self._elapsed += live
@@ -851,36 +827,6 @@ def _copy_env(env: GraspGaitEnv) -> GraspGaitEnv:
     sub._np_random = None
     sub._np_random_seed = None
     return sub
-
-
-def _grasp_map_runs(model: Any, P: int) -> NDArray[np.bool_]:
-    """The extended grasp map, transposed, as a view of every run of ``P`` contacts:
-    ``runs[c, i]`` is "contact ``c`` against contacts ``i .. i+P-1``",
-    ``GaitModel.action_mask``'s regrasp rule (thesis 4.2), for a batch of states at once."""
-    rows = np.ascontiguousarray(model.grasp_map.extended().T)
-    return np.lib.stride_tricks.sliding_window_view(rows, P, axis=1)
-
-
-def _line_views(line_src: NDArray[np.float32] | None, n: int) -> NDArray[np.float32] | None:
-    """``map_lines``: every run of ``n`` of the grasp map's rows tiled twice (the single
-    env's ``_line_src``), so that a held contact's line at angle ``k`` is row ``c``,
-    column ``(-k) mod n``; None without ``map_lines``."""
-    return (None if line_src is None
-            else np.lib.stride_tricks.sliding_window_view(line_src, n, axis=1))
-
-
-def _window_views(pooled: NDArray[np.float32], s: int, cells: int) -> NDArray[np.float32]:
-    """Every grasp-map window as a read-only view ``V[ri, rj, qi, qj]`` of shape
-    ``(s, s, ., ., cells, cells)``: the window whose origin is ``(s qi + ri, s qj + rj)``
-    in the tiled pooled map, i.e. ``pooled[i0 : i0 + s cells : s, j0 : j0 + s cells : s]``
-    with ``i0 = s qi + ri``. The map is regrouped by stride phase (a copy of its size),
-    so that each window is a contiguous-stride block and a batch of windows is one
-    fancy-indexed gather of blocks."""
-    L = -(-pooled.shape[0] // s) * s
-    padded = np.zeros((L, L), dtype=pooled.dtype)
-    padded[:pooled.shape[0], :pooled.shape[1]] = pooled
-    phases = np.ascontiguousarray(padded.reshape(L // s, s, L // s, s).transpose(1, 3, 0, 2))
-    return np.lib.stride_tricks.sliding_window_view(phases, (cells, cells), axis=(2, 3))
 
 
 def unsupported_fields(values: GraspGaitConfig | Mapping[str, Any]) -> list[str]:

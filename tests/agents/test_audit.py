@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import gymnasium as gym
 import pytest
+
 from graspgait_env.agents.audit import AUDIT_KEYS, audit_moves, summarize_audits
 from graspgait_env.agents.evaluate import ReferenceGaits, evaluate, play_episode, run_episodes
 from graspgait_env.baselines.policies import PlannerPolicy
-
 from graspgait_env.gait import GaitState
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.rule_based import rule_based

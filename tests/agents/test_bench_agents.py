@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
+
 from graspgait_env.agents.bench import (
     SHIPPED_AGENTS,
     agent_rows,
@@ -14,7 +15,6 @@ from graspgait_env.agents.bench import (
     run_agent_bench,
 )
 from graspgait_env.baselines.bench import BenchCase, bench_starts
-
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel
 

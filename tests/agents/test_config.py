@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+
 from graspgait_env.agents.config import (
     TrainConfig,
     apply_overrides,
@@ -11,7 +12,6 @@ from graspgait_env.agents.config import (
     load_train_config,
     parse_override,
 )
-
 from graspgait_env.errors import GraspGaitInputError
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 import pytest
+
 from graspgait_env.agents.envs import env_kwargs_for
 from graspgait_env.agents.evaluate import (
     ReferenceGaits,
@@ -13,7 +14,6 @@ from graspgait_env.agents.evaluate import (
     write_evaluation,
 )
 from graspgait_env.baselines.policies import PlannerPolicy
-
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.rule_based import rule_based

@@ -7,12 +7,12 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+
 from graspgait_env.agents.card import load_agent, save_agent
 from graspgait_env.agents.config import load_train_config
 from graspgait_env.agents.evaluate import evaluate
 from graspgait_env.agents.policies import PartsExtractor
 from graspgait_env.agents.train import build_model, make_vec_env_for
-
 from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions
 

@@ -6,11 +6,11 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+
 from graspgait_env.agents.card import load_agent, save_agent
 from graspgait_env.agents.config import load_train_config
 from graspgait_env.agents.policies import GraspMapExtractor, layout_of
 from graspgait_env.agents.train import build_model, make_vec_env_for
-
 from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
@@ -232,7 +232,6 @@ def test_the_env_gives_the_geometry_the_configs_gave_by_hand(name):
 
 def test_no_bundled_config_gives_an_observation_offset():
     from graspgait_env.agents.policies import ENV_GEOMETRY
-
     from graspgait_env.resources import bundled_names
 
     for name in bundled_names("train"):

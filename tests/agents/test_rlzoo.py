@@ -6,6 +6,7 @@ from importlib.resources import files
 
 import torch
 import yaml
+
 from graspgait_env.agents.card import load_agent, read_card
 from graspgait_env.agents.envs import import_object
 from graspgait_env.agents.rlzoo import TorchThreadsCallback

@@ -6,6 +6,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+
 from graspgait_env.agents.card import load_agent, save_agent
 from graspgait_env.agents.config import TrainConfig, load_train_config
 from graspgait_env.agents.policies import (
@@ -14,7 +15,6 @@ from graspgait_env.agents.policies import (
     MaskableRegraspScorerPolicy,
 )
 from graspgait_env.agents.train import build_model, init_from_model, make_vec_env_for
-
 from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 

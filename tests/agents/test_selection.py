@@ -6,12 +6,12 @@ from __future__ import annotations
 import doctest
 import json
 
-import graspgait_env.agents.train
 import pytest
+
+import graspgait_env.agents.train
 from graspgait_env.agents.card import read_card
 from graspgait_env.agents.config import load_train_config
 from graspgait_env.agents.train import selection_score, train
-
 from graspgait_env.errors import GraspGaitInputError
 
 

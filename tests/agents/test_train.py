@@ -9,10 +9,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+
 from graspgait_env.agents.card import load_agent, read_card, save_agent
 from graspgait_env.agents.config import load_train_config
 from graspgait_env.agents.train import build_model, init_from_model, make_vec_env_for, train
-
 from graspgait_env.errors import GraspGaitInputError
 
 

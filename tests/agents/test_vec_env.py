@@ -5,9 +5,9 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
-from graspgait_env.agents.vec_env import GraspGaitVecEnv, make_batched_vec_env
 
 import graspgait_env  # noqa: F401  (registers the ids)
+from graspgait_env.agents.vec_env import GraspGaitVecEnv, make_batched_vec_env
 from graspgait_env.errors import GraspGaitInputError
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+
 from graspgait_env.agents.wrappers import LegalActionWrapper, legal_substitute
 
 
@@ -66,7 +67,6 @@ def test_before_reset_and_out_of_range_the_env_answers():
 def test_solvable_starts_only_and_given_starts_kept():
     from graspgait_env.agents.evaluate import ReferenceGaits
     from graspgait_env.agents.wrappers import SolvableStartWrapper
-
     from graspgait_env.planners.exact import optimal_gait
 
     env = SolvableStartWrapper(gym.make("graspgait_env:GraspGait-v0"))
@@ -122,7 +122,6 @@ def _rule_share(env, n: int, seed: int = 0) -> tuple[float, int]:
 
 def test_rule_based_starts_make_a_quarter_of_the_hexagons_starts():
     from graspgait_env.agents.wrappers import RuleBasedStartWrapper, rule_based_starts
-
     from graspgait_env.planners.rule_based import rule_based
 
     make = lambda: gym.make("graspgait_env:GraspGait-v0", object="hexagon",  # noqa: E731

@@ -7,6 +7,7 @@ import importlib
 import gymnasium as gym
 import numpy as np
 import pytest
+
 from graspgait_env.baselines.policies import (
     PlannerPolicy,
     plan_actions,
@@ -14,7 +15,6 @@ from graspgait_env.baselines.policies import (
     planner_start,
     rebased_model,
 )
-
 from graspgait_env.envs import register_envs
 from graspgait_env.envs.map_env import GraspGaitEnv
 from graspgait_env.gait import GaitModel, GaitState

@@ -11,9 +11,9 @@ import dataclasses
 import logging
 
 import pytest
+
 from graspgait_env.baselines.bench import markdown_report, run_bench
 from graspgait_env.baselines.scale_out import bench_on_ray, campaign, parse_seeds, run_tasks
-
 from graspgait_env.cli import main
 from graspgait_env.errors import GraspGaitInputError
 

@@ -237,7 +237,6 @@ def test_start_option_errors(ellipse_env):
 
 def test_success_ends_the_episode_with_the_bonus():
     from graspgait_env.baselines.policies import plan_actions, plan_states
-
     from graspgait_env.planners.exact import optimal_gait
 
     env = make("GraspGait-v0", object="pentagon")

@@ -213,7 +213,6 @@ def test_estimate_off_the_grid_angle_removes_regrasps_outside_the_workspace():
 @pytest.mark.parametrize("pose_noise", [(0.0, 0.0), "thesis"])
 def test_optimal_planner_policy_completes_a_full_turn(pose_noise):
     from graspgait_env.baselines.policies import PlannerPolicy
-
     from graspgait_env.planners.exact import optimal_gait
 
     env = gym.make(ENV_ID, object="ellipse", mu=0.7, pose_noise=pose_noise)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
-from graspgait_env.baselines.policies import PlannerPolicy
 
+from graspgait_env.baselines.policies import PlannerPolicy
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.planners.exact import RegraspsToGo, optimal_gait
 

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from graspgait_env.baselines.policies import plan_states
 
+from graspgait_env.baselines.policies import plan_states
 from graspgait_env.gait import GaitModel, GaitState
 from graspgait_env.planners.exact import RegraspsToGo, optimal_gait
 from graspgait_env.planners.starts import spread_starts

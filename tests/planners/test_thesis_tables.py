@@ -5,6 +5,7 @@ from __future__ import annotations
 import statistics
 
 import pytest
+
 from graspgait_env.baselines.bench import (
     THESIS_OBJECTS,
     THESIS_TABLE_6_1,
@@ -14,7 +15,6 @@ from graspgait_env.baselines.bench import (
     run_case,
     summarize,
 )
-
 from graspgait_env.gait import GaitModel
 
 
@@ -92,7 +92,6 @@ def test_table_6_1_count_readings_as_measured():
     18.6). On the circle no start needs more than 8 regrasps (mean 7.96 over every legal
     start)."""
     from graspgait_env.baselines.bench import _model
-
     from graspgait_env.planners.registry import get_planner
 
     rule = get_planner("rule")
