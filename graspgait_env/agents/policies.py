@@ -426,9 +426,10 @@ class GraspMapExtractor(BaseFeaturesExtractor):
         position over ``W_h - 1``), ``l`` (which held finger is lifted) and ``kept`` (the
         kept finger's position over its ``W - 1``)."""
         lay, R = self.layout, self.rotations
-        held = observations[:, 0:3]
+        held = observations[:, lay.held]
         wd = self._widths
-        p = torch.round(observations[:, 3:6] * (wd - 1))  # workspace positions (free: < 0)
+        # workspace positions (free: < 0)
+        p = torch.round(observations[:, lay.position] * (wd - 1))
         h = torch.argmin(held, dim=1, keepdim=True)  # the free finger
         f = (h == 0).long()  # the held fingers f < g
         g = torch.where(h == 2, 1, 2)
