@@ -1069,7 +1069,8 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
         return 0
     if args.policy is None:
         raise GraspGaitInputError("POLICY missing: give random, a planner (e.g. rule), "
-                                  "greedy-reach, agent:NAME, a model .zip, config:NAME or bc; "
+                                  "greedy-reach[:D], agent:NAME, a model .zip, config:NAME or "
+                                  "bc; "
                                   f"`{PROG} benchmark --list-tasks` lists the tasks")
     from graspgait_env.baselines.scale_out import parse_seeds
     from graspgait_env.benchmark.policies import parse_policy
@@ -1126,7 +1127,8 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                        "IQM, 95% stratified bootstrap confidence intervals, a performance "
                        "profile. The row's folder (--out) keeps one file per task and seed: "
                        "run it again to resume. POLICY: random (masked), a planner, "
-                       "greedy-reach (the reach look-ahead read greedily), agent:NAME or a "
+                       "greedy-reach[:D] (the reach look-ahead read greedily, D regrasps "
+                       "deep), agent:NAME or a "
                        "model .zip, config:NAME or a training config .yaml (trained once per "
                        "task and seed), bc[:optimal|rule] (behaviour cloning from `graspgait "
                        "dataset record`). Needs the [benchmark] extra (and [train] for "
@@ -1145,7 +1147,7 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                                       "and 5 seeds (the hand track: 1-10 s per episode); "
                                       "hours for a training config"))
     p.add_argument("policy", metavar="POLICY", nargs="?",
-                   help="random, a planner name, greedy-reach, agent:NAME or a model .zip "
+                   help="random, a planner name, greedy-reach[:D], agent:NAME or a model .zip "
                    "({task}, {train_task}, {seed} in its path: one model per task and "
                    "seed), "
                    "config:NAME or a config .yaml, rlzoo:ALGO[:STEPS] (RL Zoo with the bundled "

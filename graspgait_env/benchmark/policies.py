@@ -8,13 +8,14 @@ POLICY is one of:
   ``optimal``, ``best-first``, ...), run as a policy by
   :class:`graspgait_env.baselines.policies.PlannerPolicy` (it plans from the episode's
   start, follows the plan while the state is the one it expects, replans otherwise);
-- ``greedy-reach``: a scripted greedy reading of the reach look-ahead, no learning: the
-  env gives each move the shortfall of the turn after the best chain of up to 2 more
-  regrasps (``regrasp_lookahead=3``, :class:`graspgait_env.planners.reach.RegraspReach`)
-  and the policy plays a rotation that completes the turn when one is legal, else the
-  move falling least short at depth 2, then 1, then 0 (ties: a regrasp before a
-  rotation, a shorter rotation first), with ``forbid_revisit=True``
-  (tests/envs/test_regrasp_lookahead.py);
+- ``greedy-reach`` or ``greedy-reach:D``: a scripted greedy reading of the reach
+  look-ahead, no learning: the env gives each move the shortfall of the turn after the
+  best chain of up to ``D - 1`` more regrasps (``regrasp_lookahead=D``, 3 by default, at
+  most 5; :class:`graspgait_env.planners.reach.RegraspReach`) and the policy plays a
+  rotation that completes the turn when one is legal, else the move falling least short
+  at depth ``D - 1``, then ``D - 2``, ... 0 (ties: a regrasp before a rotation, a shorter
+  rotation first), with ``forbid_revisit=True`` (tests/envs/test_regrasp_lookahead.py);
+  the row is labelled ``greedy-reach`` at the default depth, ``greedy-reach-D`` else;
 - ``agent:NAME`` or a model path (``.zip``; also a bare shipped agent name other than
   ``random``): a saved agent (:func:`graspgait_env.agents.card.load_agent`), played
   greedily with the observation settings of its card; a path with ``{task}``,
@@ -45,6 +46,7 @@ starts are the task's). Neither move rule changes the fewest regrasps from a sta
 from __future__ import annotations
 
 import dataclasses
+import functools
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -56,6 +58,7 @@ import numpy as np
 
 from graspgait_env.benchmark.suite import TASK_KEYS, Task, get_task
 from graspgait_env.errors import GraspGaitInputError
+from graspgait_env.planners.reach import MAX_REACH_DEPTH
 
 __all__ = ["CellPolicy", "PolicySpec", "parse_policy", "prepare_policy", "greedy_reach_predictor",
            "policy_env_kwargs", "train_rlzoo", "GREEDY_REACH_DEPTH", "START_WRAPPERS"]
@@ -103,8 +106,15 @@ def parse_policy(text: str) -> PolicySpec:
         return PolicySpec("random", "", "random")
     if text in PLANNERS:
         return PolicySpec("planner", text, text)
-    if text == "greedy-reach":
-        return PolicySpec("greedy-reach", "", "greedy-reach")
+    if text == "greedy-reach" or (sep and kind == "greedy-reach"):
+        depth = rest or str(GREEDY_REACH_DEPTH)
+        if not depth.isdigit() or not 1 <= int(depth) <= MAX_REACH_DEPTH + 1:
+            raise GraspGaitInputError(
+                f"POLICY {text!r}: the look-ahead depth D of greedy-reach:D is 1 to "
+                f"{MAX_REACH_DEPTH + 1} regrasps, e.g. greedy-reach:5")
+        if int(depth) == GREEDY_REACH_DEPTH:  # the default row, as before
+            return PolicySpec("greedy-reach", "", "greedy-reach")
+        return PolicySpec("greedy-reach", str(int(depth)), f"greedy-reach-{int(depth)}")
     if text == "bc" or (sep and kind == "bc"):
         demo = rest or "optimal"
         if demo not in DEMO_POLICIES:
@@ -141,7 +151,7 @@ def parse_policy(text: str) -> PolicySpec:
         return PolicySpec("agent", str(model), f"agent-{_label(stem)}")
     raise GraspGaitInputError(
         f"POLICY {text!r}: not a policy; give random, a planner ({', '.join(PLANNERS)}), "
-        "greedy-reach, a shipped agent (agent:NAME, e.g. agent:ellipse) or a model .zip, a "
+        "greedy-reach[:D], a shipped agent (agent:NAME, e.g. agent:ellipse) or a model .zip, a "
         "training config (config:NAME, e.g. config:ellipse, or a .yaml path), RL Zoo "
         "(rlzoo:ppo), or bc[:optimal|rule]")
 
@@ -422,8 +432,10 @@ def prepare_policy(spec: PolicySpec, task: Task, seed: int, workdir: str | Path,
     if spec.kind == "planner":
         return CellPolicy({}, (), _planner_predictor(spec.arg), {"planner": spec.arg})
     if spec.kind == "greedy-reach":
-        return CellPolicy({"regrasp_lookahead": GREEDY_REACH_DEPTH, "forbid_revisit": True}, (),
-                          greedy_reach_predictor, {"depth": GREEDY_REACH_DEPTH})
+        depth = int(spec.arg or GREEDY_REACH_DEPTH)
+        return CellPolicy({"regrasp_lookahead": depth, "forbid_revisit": True}, (),
+                          functools.partial(greedy_reach_predictor, depth=depth),
+                          {"depth": depth})
     if spec.kind == "agent":
         return _agent_policy(spec.arg)
     if spec.kind == "agent-template":

@@ -22,6 +22,11 @@ def test_policy_names_resolve():
     assert parse_policy("random").kind == "random"
     assert parse_policy("rule").kind == "planner" and parse_policy("optimal").arg == "optimal"
     assert parse_policy("greedy-reach").kind == "greedy-reach"
+    assert parse_policy("greedy-reach:3") == parse_policy("greedy-reach")
+    assert parse_policy("greedy-reach:5").label == "greedy-reach-5"
+    for bad in ("greedy-reach:0", "greedy-reach:6", "greedy-reach:x"):
+        with pytest.raises(GraspGaitInputError, match="depth D of greedy-reach:D is 1 to 5"):
+            parse_policy(bad)
     assert parse_policy("agent:random").kind == "agent"  # the shipped agent, not the policy
     ellipse = parse_policy("ellipse")
     assert ellipse.kind == "agent" and ellipse.arg.endswith("ellipse.zip")
@@ -58,6 +63,11 @@ def test_optimal_planner_scores_one_and_greedy_reach_nearly(tmp_path):
     for c in greedy["cells"]:
         assert c["env_kwargs"]["regrasp_lookahead"] == 3 and c["env_kwargs"]["forbid_revisit"]
         assert c["summary"]["success"] == 1.0 and c["summary"]["efficiency"] > 0.7
+    deep = run_benchmark("greedy-reach:5", tasks[:1], [0], out_dir=tmp_path / "g5",
+                         episodes=2, progress=False, reps=100)
+    cell = deep["cells"][0]
+    assert cell["env_kwargs"]["regrasp_lookahead"] == 5 and cell["policy_info"]["depth"] == 5
+    assert cell["summary"]["success"] == 1.0
 
 
 def test_a_shipped_agent_on_its_task(tmp_path):
