@@ -982,6 +982,36 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_story)
 
 
+def _cmd_card(args: argparse.Namespace) -> int:
+    from graspgait_env.agents.hub_card import write_hub_card
+
+    text = write_hub_card(args.models, args.out, args.title)
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        print(f"wrote {args.out}")
+    return 0
+
+
+def _add_card(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("card", help="write a Hugging Face-style model card over seeds",
+                       description="The model card of one recipe's runs, in the form the "
+                       "Hugging Face Hub and CleanRL use: YAML front matter (library_name, "
+                       "tags, model-index with each metric as mean +/- std over the runs), "
+                       "the env id and keywords, the metrics per run and over runs, the "
+                       "hyper-parameters and the commands that reproduce it, all read from "
+                       "the runs' own JSON cards (one per seed, e.g. the run folders of "
+                       "`graspgait train CONFIG --seeds 0-4`). Runs of different recipes "
+                       "(algo, env id or env keywords) are refused.",
+                       epilog=_epilog(["card runs/*general*/model.zip --out README.md",
+                                       "card ellipse"], duration="a second"))
+    p.add_argument("models", metavar="MODEL", nargs="+",
+                   help="saved models (zips with their cards) or shipped agents' names")
+    p.add_argument("--out", metavar="FILE", help="write the card here (default: print it)")
+    p.add_argument("--title", help="the card's heading (default: recipe and env id)")
+    p.set_defaults(func=_cmd_card)
+
+
 # --- config ---------------------------------------------------------------------------
 
 
@@ -1236,6 +1266,7 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
     _add_train,
     _add_evaluate,
     _add_story,
+    _add_card,
     _add_config,
     _add_benchmark,
     _add_dataset,

@@ -33,7 +33,7 @@ def _help(capsys, *argv: str) -> str:
 
 def test_every_subcommand_is_covered():
     assert set(_subparsers()) == {"map", "sweep", "plan", "bench", "simulate", "perf", "train",
-                                  "evaluate", "story", "config", "benchmark", "dataset"}
+                                  "evaluate", "story", "card", "config", "benchmark", "dataset"}
 
 
 @pytest.mark.parametrize("command", sorted(_subparsers()))
