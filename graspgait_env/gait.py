@@ -43,7 +43,7 @@ import math
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from graspgait_env.contact_model import POINT_CONTACTS, ContactModel
 from graspgait_env.errors import GraspGaitInputError
@@ -336,6 +336,34 @@ class GaitModel:
         b = 2 * self.R
         mask[b : b + 2 * W : 2] = self._rows[c[g], i0 : i0 + W]  # lift f (lower), keep g
         mask[b + 1 : b + 2 * W : 2] = self._rows[c[f], i0 : i0 + W]  # lift g, keep f
+        return mask
+
+    def action_masks_at(self, k: ArrayLike, f: ArrayLike, g: ArrayLike, pf: ArrayLike,
+                        pg: ArrayLike) -> NDArray[np.bool_]:
+        """:meth:`action_mask` of a batch of states given by their held fingers'
+        workspace positions: row ``i`` is the mask of the state at object angle ``k[i]``
+        (grid steps) whose fingers ``f[i] < g[i]`` hold at workspace positions
+        ``pf[i]``, ``pg[i]`` (the free finger is ``3 - f - g``); shape ``(N,
+        n_actions)``. The same rule as :meth:`action_mask`, row for row (tested), for
+        the searches that open a whole frontier at once
+        (:func:`~graspgait_env.planners.search.breadth_first`)."""
+        k, f, g, pf, pg = (np.asarray(x, dtype=np.int64).ravel() for x in (k, f, g, pf, pg))
+        R, n = self.R, self.n
+        h = 3 - f - g
+        mask = np.zeros((k.size, self.n_actions), dtype=bool)
+        ccw, cw = rotation_room_of(self.ws_width, f, pf, g, pg)
+        steps = np.arange(R)
+        mask[:, :R] = steps < ccw[:, None]
+        mask[:, R:2 * R] = steps < cw[:, None]
+        st = self.ws_start
+        i0 = (st[h] - k) % n
+        cols = i0[:, None] + self._positions  # < 2n: the extended map's columns
+        valid = self._positions < self.ws_width[h][:, None]
+        cf = (st[f] + pf - k) % n
+        cg = (st[g] + pg - k) % n
+        b = 2 * R
+        mask[:, b::2] = self._rows[cg[:, None], cols] & valid  # lift f (lower), keep g
+        mask[:, b + 1::2] = self._rows[cf[:, None], cols] & valid  # lift g, keep f
         return mask
 
     def decode(self, s: GaitState, action: int) -> Move:

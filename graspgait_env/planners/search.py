@@ -3,9 +3,10 @@
 All three search the discretized gait graph of :class:`~graspgait_env.gait.GaitModel`
 (thesis 5.2: a node is ``X = [theta, x, y]``, a branch is one rotation or one regrasp)
 and expand a node with the one legal-move function, :meth:`GaitModel.action_mask`,
-called once per expansion; the legal actions are then decoded into next states all at
-once with NumPy, exactly as :meth:`GaitModel.apply` decodes one (a test checks that the
-two agree move for move).
+called once per expansion (breadth-first search opens a whole level at once with its
+batched form, :meth:`GaitModel.action_masks_at`, the same rule row for row); the legal
+actions are then decoded into next states all at once with NumPy, exactly as
+:meth:`GaitModel.apply` decodes one (a test checks that the two agree move for move).
 
 Common rules
 ------------
@@ -38,7 +39,6 @@ from __future__ import annotations
 import heapq
 import math
 import time
-from collections import deque
 from collections.abc import Callable
 
 import numpy as np
@@ -62,10 +62,13 @@ __all__ = [
 ]
 
 DEFAULT_MAX_NODES = 200_000  # (nodes opened) default cap for every search here
+_CHUNK = 4096  # breadth-first: nodes opened per batched expansion
 TIE_BREAKS = ("oldest", "newest")  # best-first: which of equal-M open nodes goes first
 
 _PAIRS = ((0, 1), (0, 2), (1, 2))
 _PAIR_INDEX = {p: i for i, p in enumerate(_PAIRS)}
+_PAIR_F = np.array([f for f, _ in _PAIRS], dtype=np.int64)  # pair index -> lower finger
+_PAIR_G = np.array([g for _, g in _PAIRS], dtype=np.int64)  # pair index -> higher finger
 
 
 def best_first_metric(theta_deg: ArrayLike, regrasps: ArrayLike, rotations: ArrayLike,
@@ -217,6 +220,55 @@ class _Graph:
                  + pg * self.act_cg[pair, acts])
         return codes, acts, kc
 
+    def children_many(self, codes: NDArray[np.int64]
+                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """:meth:`children` of many nodes at once: ``(source, child codes, k)``, in the
+        order the nodes are given and, within a node, in action order (one
+        :meth:`GaitModel.action_masks_at` call); ``source[i]`` indexes ``codes``."""
+        kk, rem = np.divmod(codes, 3 * self.PP)
+        pair, rem = np.divmod(rem, self.PP)
+        pf, pg = np.divmod(rem, self.P)
+        k = kk + self.k_lo
+        f, g = _PAIR_F[pair], _PAIR_G[pair]
+        src, acts = np.nonzero(self.model.action_masks_at(k, f, g, pf, pg))  # row-major
+        kc = k[src] + self.act_dk[acts]
+        inside = (kc >= self.k_lo) & (kc <= self.k_hi)
+        src, acts, kc = src[inside], acts[inside], kc[inside]
+        pa = pair[src]
+        out = (kk[src] * 3 * self.PP + self.act_off[pa, acts] + pf[src] * self.act_cf[pa, acts]
+               + pg[src] * self.act_cg[pa, acts])
+        return src, out, kc
+
+    def expand_many(self, codes: NDArray[np.int64], budget: int) -> tuple[NDArray[np.int64], int]:
+        """Open nodes ``codes`` in their order, as :meth:`expand` would one after another,
+        stopping after the node that creates the goal or after ``budget`` nodes.
+
+        Returns the new children in the order :meth:`expand` would create them (each
+        node's new children in action order, a child created once, by the first node
+        that reaches it) and the number of nodes opened. Parents, ``created``, ``best``
+        and ``goal`` end as after that many :meth:`expand` calls (tested against them).
+        """
+        codes = codes[:budget]
+        src, kids, kc = self.children_many(codes)
+        new = self.parent[kids] < 0
+        src, kids, kc = src[new], kids[new], kc[new]
+        _, first = np.unique(kids, return_index=True)  # the first node to reach each child
+        first.sort()
+        src, kids, kc = src[first], kids[first], kc[first]
+        opened = codes.size
+        hit = np.flatnonzero(kc * self.sign >= self.sign * self.K) if kids.size else kids
+        if self.goal < 0 and hit.size:  # the goal is created by node src[hit[0]]: stop there
+            last = int(src[hit[0]])
+            opened = last + 1
+            keep = src <= last
+            src, kids, kc = src[keep], kids[keep], kc[keep]
+            self.goal = int(kids[hit[0]])
+        if kids.size:
+            self.parent[kids] = codes[src]
+            self.created += int(kids.size)
+            self.best = max(self.best, int((kc * self.sign).max()))
+        return kids, opened
+
     def expand(self, code: int
                ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
         """Open node ``code``: its *new* children's codes, actions and is-regrasp flags.
@@ -312,6 +364,13 @@ def breadth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 3
     only once (visited set), and the goal is tested at creation, so the path found is
     a shortest one in moves (rotations + regrasps) within the window.
 
+    A level is opened in batches of up to 4,096 nodes (one
+    :meth:`~graspgait_env.gait.GaitModel.action_masks_at` call each), in queue order,
+    with each child credited to the first node that reaches it: the plan, the counts and
+    the node limit are those of a FIFO queue opened one node at a time (tested against
+    it), about 5x faster on a search that runs to the 200,000-node limit (0.62 s against
+    3.06 s from a start of the circle at mu 0.7).
+
     Parameters
     ----------
     model
@@ -345,12 +404,18 @@ def breadth_first(model: GaitModel, start: GaitState | None, turn_deg: float = 3
     if G is None:  # no stable grasp at theta = 0: no gait
         return s0
     opened = 0
-    queue: deque[int] = deque([G.start_code])
-    while G.goal < 0 and queue and opened < max_nodes:
-        code = queue.popleft()
-        opened += 1
-        codes, _, _ = G.expand(code)
-        queue.extend(codes.tolist())
+    frontier = np.array([G.start_code], dtype=np.int64)
+    while G.goal < 0 and frontier.size and opened < max_nodes:
+        # one level at a time, in chunks (bounded memory), each chunk opened in queue
+        # order: the same nodes, parents and counts as a FIFO queue opened one by one
+        nxt: list[NDArray[np.int64]] = []
+        for lo in range(0, frontier.size, _CHUNK):
+            kids, n_open = G.expand_many(frontier[lo:lo + _CHUNK], max_nodes - opened)
+            opened += n_open
+            nxt.append(kids)
+            if G.goal >= 0 or opened >= max_nodes:
+                break
+        frontier = np.concatenate(nxt)
     return G.result("breadth-first", opened, t0, max_nodes, s0, turn_deg, {})
 
 

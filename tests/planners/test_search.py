@@ -7,7 +7,7 @@ import pytest
 
 from graspgait_env import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
-from graspgait_env.plan import validate_plan
+from graspgait_env.plan import plan_from_states, validate_plan
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.search import (
     _Graph,
@@ -368,3 +368,64 @@ def _check_result_any(model: GaitModel, res) -> None:
     assert res.path_length == len(res.plan.steps) - 1
     assert res.regrasps == res.plan.regrasps
     assert 1 <= res.nodes_opened <= res.nodes_created
+
+
+# --------------------------------------------------------------------------- batched BFS
+def _fifo_breadth_first(model: GaitModel, start: GaitState, turn_deg: float,
+                        max_nodes: int) -> tuple:
+    """The reference: breadth-first search opened one node at a time from a FIFO queue
+    with :meth:`_Graph.expand` (one ``action_mask`` call per node)."""
+    from collections import deque
+
+    G = _Graph(model, start, turn_deg, None)
+    opened, queue = 0, deque([G.start_code])
+    while G.goal < 0 and queue and opened < max_nodes:
+        code = queue.popleft()
+        opened += 1
+        queue.extend(G.expand(code)[0].tolist())
+    path = G.path() if G.goal >= 0 else None
+    return opened, G.created, G.best, path
+
+
+@pytest.mark.parametrize("name,turn,max_nodes", [
+    ("circle", 360.0, 3000), ("ellipse", -90.0, 20_000), ("pentagon", 360.0, 6000),
+    ("hexagon", 30.0, 50_000), ("square", 180.0, 9001)])
+def test_breadth_first_batched_equals_fifo_queue(name, turn, max_nodes):
+    """The level-by-level batched search opens the same nodes as a FIFO queue opened one
+    by one: the same plan, nodes opened and created and largest turn, both when the goal
+    is found and when the node limit stops it mid-level."""
+    model = _model(name, 90)
+    for s in model.start_states()[::97][:4]:
+        res = breadth_first(model, s, turn, max_nodes=max_nodes)
+        opened, created, best, path = _fifo_breadth_first(model, s, turn, max_nodes)
+        assert res.nodes_opened == opened and res.nodes_created == created
+        assert res.max_turn_deg == pytest.approx(np.sign(turn) * best * model.step_deg)
+        if path is None:
+            assert res.plan is None
+        else:
+            assert res.plan is not None
+            ref = plan_from_states(model, path)
+            ref.stats = res.plan.stats  # the counts, checked above
+            assert res.plan.to_json() == ref.to_json()
+
+
+def test_action_masks_at_equals_action_mask():
+    """The batched legal-move rule is :meth:`GaitModel.action_mask` row for row, at
+    angles all round the window (negative ones included)."""
+    model = _model("hexagon", 180)
+    rng = np.random.default_rng(3)
+    rows, want = [], []
+    for s in model.start_states()[::11]:
+        k = int(rng.integers(-400, 400))
+        f, g = s.held()
+        pf, pg = (model.position(x, s.contacts[x], 0) for x in (f, g))
+        cs = list(s.contacts)
+        for x in (f, g):  # the same workspace positions at angle k
+            cs[x] = (s.contacts[x] - k) % model.n
+        rows.append((k, f, g, pf, pg))
+        want.append(model.action_mask(GaitState(k, tuple(cs))))
+    k, f, g, pf, pg = (np.array(c) for c in zip(*rows, strict=True))
+    got = model.action_masks_at(k, f, g, pf, pg)
+    assert got.shape == (len(rows), model.n_actions)
+    assert got.any(axis=1).all()
+    np.testing.assert_array_equal(got, np.stack(want))
