@@ -511,25 +511,42 @@ def depth_first_thesis(model: GaitModel, start: GaitState | None, turn_deg: floa
     frames: list[list[int]] = []  # per path node: its children not yet tried, last first
     goal = G.start_code if G.goal >= 0 else -1
 
+    # a tree search opens the same few states again and again (on the ellipse, 131,072
+    # openings of 18 states): what opening a state gives is kept per state
+    opening: dict[int, tuple[int, int, int, list[int]]] = {}
+
+    def open_state(code: int) -> tuple[int, int, int, list[int]]:
+        """``(children, largest turn toward the goal, goal child or -1, frame)`` of
+        ``code``: the frame is its children in the order they are tried, last first."""
+        codes, acts, kc = G.children(code)
+        is_reg = G.act_is_reg[acts]
+        fwd = ~is_reg & ((acts < R) if sign > 0 else (acts >= R))
+        along = kc * sign
+        far = int(along[fwd].max()) if fwd.any() else best_none
+        hit = fwd & (along >= sign * K)
+        if hit.any():  # the goal child nearest the goal angle: the plan ends at K
+            return codes.size, far, int(codes[np.flatnonzero(hit)[np.argmin(along[hit])]]), []
+        rot = codes[fwd][np.argsort(along[fwd], kind="stable")]  # smallest first ...
+        order = np.concatenate((codes[is_reg][::-1], rot))  # ... so the largest pops first
+        return codes.size, far, -1, order.tolist()
+
+    best_none = -(2**62)
+
     def open_node(code: int) -> int:
         """Expand ``code``: push its frame; the goal child if one is created, else -1."""
         nonlocal opened, created, best
         opened += 1
         path.append(code)
         on_path.add(code)
-        codes, acts, kc = G.children(code)
-        created += int(codes.size)
-        is_reg = G.act_is_reg[acts]
-        fwd = ~is_reg & ((acts < R) if sign > 0 else (acts >= R))
-        along = kc * sign
-        if fwd.any():
-            best = max(best, int(along[fwd].max()))
-            hit = fwd & (along >= sign * K)
-            if hit.any():  # the goal child nearest the goal angle: the plan ends at K
-                return int(codes[np.flatnonzero(hit)[np.argmin(along[hit])]])
-        rot = codes[fwd][np.argsort(along[fwd], kind="stable")]  # smallest first ...
-        order = np.concatenate((codes[is_reg][::-1], rot))  # ... so the largest pops first
-        frames.append(order.tolist())
+        got = opening.get(code)
+        if got is None:
+            got = opening[code] = open_state(code)
+        n_children, far, goal_child, order = got
+        created += n_children
+        best = max(best, far)
+        if goal_child >= 0:
+            return goal_child
+        frames.append(order.copy())
         return -1
 
     if goal < 0:

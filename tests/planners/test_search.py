@@ -429,3 +429,71 @@ def test_action_masks_at_equals_action_mask():
     assert got.shape == (len(rows), model.n_actions)
     assert got.any(axis=1).all()
     np.testing.assert_array_equal(got, np.stack(want))
+
+
+def _dfs_thesis_counts(model: GaitModel, start: GaitState, turn_deg: float,
+                       max_nodes: int) -> tuple:
+    """The reference: the thesis's tree search with every node expanded afresh
+    (:meth:`_Graph.children` at each opening, nothing kept per state)."""
+    G = _Graph(model, start, turn_deg, None)
+    R, sign, K = model.R, G.sign, G.K
+    opened, created, best = 0, 1, 0
+    path: list[int] = []
+    frames: list[list[int]] = []
+    goal = G.start_code if G.goal >= 0 else -1
+
+    def open_node(code: int) -> int:
+        nonlocal opened, created, best
+        opened += 1
+        path.append(code)
+        codes, acts, kc = G.children(code)
+        created += int(codes.size)
+        is_reg = G.act_is_reg[acts]
+        fwd = ~is_reg & ((acts < R) if sign > 0 else (acts >= R))
+        along = kc * sign
+        if fwd.any():
+            best = max(best, int(along[fwd].max()))
+            hit = fwd & (along >= sign * K)
+            if hit.any():
+                return int(codes[np.flatnonzero(hit)[np.argmin(along[hit])]])
+        rot = codes[fwd][np.argsort(along[fwd], kind="stable")]
+        frames.append(np.concatenate((codes[is_reg][::-1], rot)).tolist())
+        return -1
+
+    if goal < 0:
+        goal = open_node(G.start_code)
+    while goal < 0 and frames and opened < max_nodes:
+        if not frames[-1]:
+            frames.pop()
+            path.pop()
+            continue
+        child = frames[-1].pop()
+        if child not in path:
+            goal = open_node(child)
+    return opened, created, best, (path + [goal] if goal >= 0 else None)
+
+
+@pytest.mark.parametrize("name", ["circle", "ellipse", "pentagon", "hexagon"])
+def test_depth_first_thesis_equals_search_without_kept_openings(name):
+    """What the tree search keeps per state changes nothing: the same nodes opened and
+    created, largest turn and path as expanding every opening afresh, to the node limit
+    and to the goal, both ways round."""
+    from graspgait_env.planners.search import depth_first_thesis
+
+    model = _model(name, 90)
+    outcomes = set()
+    for s in model.start_states()[::50][:4]:
+        for turn in (360.0, -180.0):
+            res = depth_first_thesis(model, s, turn, max_nodes=5000)
+            opened, created, best, path = _dfs_thesis_counts(model, s, turn, 5000)
+            assert (res.nodes_opened, res.nodes_created) == (opened, created)
+            assert res.max_turn_deg == pytest.approx(np.sign(turn) * best * model.step_deg)
+            assert (res.plan is None) == (path is None)
+            if path is not None:
+                ref = plan_from_states(model, [_Graph(model, s, turn, None).decode(c)
+                                               for c in path])
+                ref.stats = res.plan.stats
+                assert res.plan.to_json() == ref.to_json()
+            outcomes.add(res.plan is not None)
+    if name == "hexagon":
+        assert outcomes == {True, False}  # both outcomes are checked here
