@@ -256,8 +256,8 @@ class _Graph:
         first.sort()
         src, kids, kc = src[first], kids[first], kc[first]
         opened = codes.size
-        hit = np.flatnonzero(kc * self.sign >= self.sign * self.K) if kids.size else kids
-        if self.goal < 0 and hit.size:  # the goal is created by node src[hit[0]]: stop there
+        hit = np.flatnonzero(kc * self.sign >= self.sign * self.K)
+        if hit.size:  # the goal is created by node src[hit[0]]: stop there
             last = int(src[hit[0]])
             opened = last + 1
             keep = src <= last
@@ -522,15 +522,13 @@ def depth_first_thesis(model: GaitModel, start: GaitState | None, turn_deg: floa
         is_reg = G.act_is_reg[acts]
         fwd = ~is_reg & ((acts < R) if sign > 0 else (acts >= R))
         along = kc * sign
-        far = int(along[fwd].max()) if fwd.any() else best_none
+        far = int(along[fwd].max()) if fwd.any() else 0  # best starts at 0: no change
         hit = fwd & (along >= sign * K)
         if hit.any():  # the goal child nearest the goal angle: the plan ends at K
             return codes.size, far, int(codes[np.flatnonzero(hit)[np.argmin(along[hit])]]), []
         rot = codes[fwd][np.argsort(along[fwd], kind="stable")]  # smallest first ...
         order = np.concatenate((codes[is_reg][::-1], rot))  # ... so the largest pops first
         return codes.size, far, -1, order.tolist()
-
-    best_none = -(2**62)
 
     def open_node(code: int) -> int:
         """Expand ``code``: push its frame; the goal child if one is created, else -1."""
