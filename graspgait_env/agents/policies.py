@@ -106,9 +106,6 @@ REGRASP_CHANNELS = 9
 """Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
 _ACTION_CHANNELS = 3  # with reach_depth: legal, is a rotation, the rotation's steps
 
-_HEADER = 16  # ObservationLayout's header: held, positions, contact and object angles, turn
-
-
 def layout_of(observation_space: gym.spaces.Box, cells: int, line_cells: int,
               tail: int = 0) -> ObservationLayout:
     """The :class:`ObservationLayout` of a GraspGait observation space of known window size.
@@ -131,7 +128,7 @@ def layout_of(observation_space: gym.spaces.Box, cells: int, line_cells: int,
         raise GraspGaitInputError(
             f"features_extractor_kwargs cells={cells}, line_cells={line_cells}, tail={tail}: "
             "cells must be >= 1 and line_cells, tail >= 0, e.g. cells: 36, line_cells: 180")
-    n_actions = int(shape[0]) - _HEADER - cells * cells - 2 * line_cells - tail
+    n_actions = int(shape[0]) - ObservationLayout.HEADER - cells * cells - 2 * line_cells - tail
     if n_actions < 1:
         raise GraspGaitInputError(
             f"features_extractor_kwargs cells={cells}, line_cells={line_cells}, tail={tail}: "

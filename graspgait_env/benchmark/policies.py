@@ -293,7 +293,7 @@ class CellPolicy:
     wrappers: tuple[str, ...]
     make_predict: Callable[[gym.Env], Predict]
     info: dict[str, Any] = field(default_factory=dict)
-    observation_shape: tuple[int, ...] | None = None
+    observation_shape: tuple | None = None
 
     def wrap(self, env: gym.Env) -> gym.Env:
         """The env as the predictor expects it (an episode-start marker outermost)."""
@@ -366,7 +366,16 @@ def _agent_policy(model_path: str, info: dict[str, Any] | None = None) -> CellPo
     meta = {"model": str(model_path), "algo": card.get("algo"), "steps": card.get("steps"),
             "train_wall_s": card.get("wall_s"), **(info or {})}
     return CellPolicy(dict(card.get("env_kwargs") or {}), wrappers, lambda env: predict,
-                      meta, tuple(model.observation_space.shape))
+                      meta, observation_signature(model.observation_space))
+
+
+def observation_signature(space: gym.Space) -> tuple:
+    """What a policy and a task's env must agree on about an observation space: a
+    ``Box``'s shape, or each part's name and shape for a ``Dict`` (``observation_mode:
+    dict``)."""
+    if isinstance(space, gym.spaces.Dict):
+        return tuple((k, tuple(v.shape)) for k, v in space.spaces.items())
+    return tuple(space.shape)
 
 
 def _one_thread() -> None:

@@ -41,6 +41,7 @@ from typing import Any
 from graspgait_env.atomic import json_ready, write_text_atomic
 from graspgait_env.benchmark.policies import (
     PolicySpec,
+    observation_signature,
     parse_policy,
     policy_env_kwargs,
     prepare_policy,
@@ -88,7 +89,7 @@ def run_cell(spec: PolicySpec | dict, task_id: str, seed: int, episodes: int | N
     kwargs = policy_env_kwargs(task, policy.env_kwargs)
     env = policy.wrap(make_env(task.env_id, kwargs, policy.wrappers))
     try:
-        shape = tuple(env.observation_space.shape)
+        shape = observation_signature(env.observation_space)
         if policy.observation_shape is not None and shape != policy.observation_shape:
             raise GraspGaitInputError(
                 f"POLICY {spec.label}: observes {policy.observation_shape}, task {task.id} "

@@ -122,7 +122,12 @@ class ObservationLayout:
         ``actions``, ``window``, then ``lines`` with ``map_lines``).
     flat_size
         Length of the flattened dict.
+    HEADER
+        (class attribute) Entries of the box vector before ``mask``: the grasp and
+        turn state, whatever the window and the opt-in fields.
     """
+
+    HEADER: int = _HEADER
 
     def __init__(self, n_actions: int, cells: int, line_cells: int = 0,
                  lookahead: int = 0, reach: int = 0) -> None:

@@ -205,29 +205,41 @@ def test_forward_gait_features_need_the_hand_widths():
         GraspMapExtractor(env.observation_space, workspace_widths=[46, 46, 46])
 
 
-# the geometry the bundled configs gave by hand until the trainer read it from the env
-# (their shipped models were trained with these; agents/models/*.md)
+# the geometry the configs of graspgait_env 0.2 gave GraspMapExtractor by hand, until the
+# trainer read it from the env: their env and extractor keywords (the models trained with
+# them load with this extractor) and the hand-written figures
 _HAND_WRITTEN = {
-    "ellipse": {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
-                "rotations": 45},
-    "hexagon": {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
-                "rotations": 45, "workspace_widths": [46, 46, 46]},
-    "random": {"cells": 1, "line_cells": 0, "conv": False, "tail": 546, "turn_steps": 180,
-               "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 3,
-               "reach_relative": True, "reach_best": True},
+    "ellipse": ("GraspGait-v0",
+                {"object": "ellipse", "mu": 0.7, "contact_model": "hand",
+                 "rotation_lookahead": True, "map_lines": False, "map_window_cells": 1},
+                {"conv": False, "finishing_rotations": True},
+                {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
+                 "rotations": 45}),
+    "hexagon": ("GraspGait-v0",
+                {"object": "hexagon", "mu": 0.7, "contact_model": "hand",
+                 "rotation_lookahead": True, "map_lines": False, "map_window_cells": 1},
+                {"conv": False, "forward_gait": True},
+                {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
+                 "rotations": 45, "workspace_widths": [46, 46, 46]}),
+    "random": ("GraspGaitRandom-v0",
+               {"level": 1, "map_lines": False, "map_window_cells": 1,
+                "regrasp_lookahead": 3},
+               {"conv": False, "action_block": True, "reach_relative": True,
+                "reach_best": True},
+               {"cells": 1, "line_cells": 0, "conv": False, "tail": 546, "turn_steps": 180,
+                "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 3,
+                "reach_relative": True, "reach_best": True}),
 }
 
 
 @pytest.mark.parametrize("name", sorted(_HAND_WRITTEN))
 def test_the_env_gives_the_geometry_the_configs_gave_by_hand(name):
     from graspgait_env.agents.envs import make_env
-    from graspgait_env.agents.policies import ENV_GEOMETRY, extractor_kwargs_for
+    from graspgait_env.agents.policies import extractor_kwargs_for
 
-    cfg = load_train_config(name)
-    assert not set(cfg.features_extractor_kwargs) & set(ENV_GEOMETRY), (
-        f"configs/train/{name}.yaml gives an observation offset")
-    env = make_env(cfg.env_id, cfg.env_kwargs)
-    assert extractor_kwargs_for(env, cfg.features_extractor_kwargs) == _HAND_WRITTEN[name]
+    env_id, env_kwargs, choices, by_hand = _HAND_WRITTEN[name]
+    env = make_env(env_id, env_kwargs)
+    assert extractor_kwargs_for(env, choices) == by_hand
 
 
 def test_no_bundled_config_gives_an_observation_offset():

@@ -80,6 +80,17 @@ def test_a_shipped_agent_on_its_task(tmp_path):
     assert cell["summary"]["success"] == 1.0
 
 
+def test_an_agent_on_the_named_parts_is_scored(tmp_path):
+    """The shipped ellipse reads a Dict observation (observation_mode: dict): its cells
+    run, and the task's env keeps the agent's parts."""
+    row = run_benchmark("agent:ellipse", parse_tasks("map-hand-ellipse"), [0],
+                        out_dir=tmp_path / "e", episodes=2, progress=False, reps=100)
+    assert not row["failures"], row["failures"]
+    cell = row["cells"][0]
+    assert cell["env_kwargs"]["observation_mode"] == "dict"
+    assert cell["summary"]["solvable"] == cell["summary"]["successes"] >= 1
+
+
 def test_a_config_trains_once_per_training_task_and_seed(tmp_path):
     out = tmp_path / "cfg"
     row = run_benchmark("config:smoke", parse_tasks("map-hand-circle,mujoco-friction-circle"),
