@@ -176,6 +176,24 @@ def _algo_class(algo: str) -> type:
     return PPO
 
 
+def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
+    """The keyword arguments ``config``'s features extractor is built with: the config's
+    own, and for :class:`~graspgait_env.agents.policies.GraspMapExtractor` the geometry
+    of the observation, which comes from the env (its ``ObservationLayout``, through
+    :func:`~graspgait_env.agents.policies.extractor_kwargs_for`), never from the config."""
+    from graspgait_env.agents.policies import GraspMapExtractor, extractor_kwargs_for
+
+    kwargs = dict(config.features_extractor_kwargs)
+    if config.features_extractor is None:
+        return kwargs
+    extractor = import_object(config.features_extractor, "features_extractor")
+    if isinstance(extractor, type) and issubclass(extractor, GraspMapExtractor):
+        probe = make_env(config.env_id, config.env_kwargs)
+        kwargs = extractor_kwargs_for(probe, kwargs)
+        probe.close()
+    return kwargs
+
+
 def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
     """A fresh PPO / MaskablePPO model for ``config`` on the vector env ``env``."""
     import torch
@@ -185,18 +203,9 @@ def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = Non
         "activation_fn": {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config.activation],
     }
     if config.features_extractor is not None:
-        extractor = import_object(config.features_extractor, "features_extractor")
-        policy_kwargs["features_extractor_class"] = extractor
-        kwargs = dict(config.features_extractor_kwargs)
-        from graspgait_env.agents.policies import GraspMapExtractor, extractor_kwargs_for
-
-        if isinstance(extractor, type) and issubclass(extractor, GraspMapExtractor):
-            # the observation's geometry comes from the env (its ObservationLayout),
-            # never from the config
-            probe = make_env(config.env_id, config.env_kwargs)
-            kwargs = extractor_kwargs_for(probe, kwargs)
-            probe.close()
-        policy_kwargs["features_extractor_kwargs"] = kwargs
+        policy_kwargs["features_extractor_class"] = import_object(config.features_extractor,
+                                                                  "features_extractor")
+        policy_kwargs["features_extractor_kwargs"] = extractor_kwargs(config)
     lr: Any = config.learning_rate
     if config.lr_schedule == "linear":
         lr0 = config.learning_rate

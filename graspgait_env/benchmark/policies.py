@@ -286,14 +286,16 @@ class CellPolicy:
     ``env_kwargs`` are its own env keywords (merged under the task's by
     :func:`policy_env_kwargs`), ``wrappers`` its Gymnasium wrappers (import paths);
     ``make_predict(env)`` gives ``predict(obs, mask) -> action`` for the env built from
-    them; ``info`` says what lies behind it (model, training steps and wall time).
+    them; ``info`` says what lies behind it (model, training steps and wall time);
+    ``observes`` (:func:`observation_signature`), where known, is the observation the
+    policy was trained on, which the task's env must give.
     """
 
     env_kwargs: dict[str, Any]
     wrappers: tuple[str, ...]
     make_predict: Callable[[gym.Env], Predict]
     info: dict[str, Any] = field(default_factory=dict)
-    observation_shape: tuple | None = None
+    observes: tuple | None = None
 
     def wrap(self, env: gym.Env) -> gym.Env:
         """The env as the predictor expects it (an episode-start marker outermost)."""

@@ -89,11 +89,11 @@ def run_cell(spec: PolicySpec | dict, task_id: str, seed: int, episodes: int | N
     kwargs = policy_env_kwargs(task, policy.env_kwargs)
     env = policy.wrap(make_env(task.env_id, kwargs, policy.wrappers))
     try:
-        shape = observation_signature(env.observation_space)
-        if policy.observation_shape is not None and shape != policy.observation_shape:
+        gives = observation_signature(env.observation_space)
+        if policy.observes is not None and gives != policy.observes:
             raise GraspGaitInputError(
-                f"POLICY {spec.label}: observes {policy.observation_shape}, task {task.id} "
-                f"gives {shape} (its own env settings: hand, grid or map window differ)")
+                f"POLICY {spec.label}: observes {policy.observes}, task {task.id} "
+                f"gives {gives} (its own env settings: hand, grid or map window differ)")
         t1 = time.perf_counter()
         records = run_episodes(policy.make_predict(env), env, n, seed=first,
                                references=_references())

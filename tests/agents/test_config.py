@@ -102,8 +102,7 @@ def test_each_shipped_model_card_holds_its_bundled_config(name):
     import json
 
     from graspgait_env.agents.bench import shipped_models_dir
-    from graspgait_env.agents.envs import import_object, make_env
-    from graspgait_env.agents.policies import GraspMapExtractor, extractor_kwargs_for
+    from graspgait_env.agents.train import extractor_kwargs
 
     card = shipped_models_dir() / f"{name}.json"
     assert card.is_file(), f"the shipped card {card} is missing from this install"
@@ -111,10 +110,7 @@ def test_each_shipped_model_card_holds_its_bundled_config(name):
     # run_root is where the run was written, not how it was trained
     bundled = load_train_config(name, [f"run_root={shipped['config']['run_root']}"])
     trained = TrainConfig(**shipped["config"])
-    kw = bundled.features_extractor_kwargs
-    if bundled.features_extractor is not None and issubclass(
-            import_object(bundled.features_extractor, "features_extractor"), GraspMapExtractor):
-        kw = extractor_kwargs_for(make_env(bundled.env_id, bundled.env_kwargs), kw)
+    kw = extractor_kwargs(bundled)
     assert kw == trained.features_extractor_kwargs
     assert dataclasses.replace(bundled, features_extractor_kwargs=kw) == trained
     assert shipped["env_kwargs"] == shipped["config"]["env_kwargs"]
