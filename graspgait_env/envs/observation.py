@@ -42,7 +42,17 @@ turn's sign; thesis 5.2 for rotations, 4.2 for regrasps):
 ``reach_j``   with ``regrasp_lookahead = D``, ``j = 1 .. D``: the reach look-ahead,
               ``j - 1`` more regrasps deep (the box vector's ``reach`` part, per
               action; an illegal move reads its maximum, "none").
+``reach_rank`` with ``regrasp_lookahead``: the move's place in the greedy reading of the
+              reach look-ahead (:func:`greedy_ranks`), over ``A - 1``: 0 for the move
+              that reading plays, 1 for an illegal move.
 ============  ======================================================================
+
+Why ``reach_rank``: the greedy reading is a lexicographic order over the ``D`` reach
+columns with tie rules, which a small network learns poorly from labels; given the rank,
+a policy need only learn where to depart from it. Measured (CHANGELOG, 2026-12-04): the
+``general`` recipe at ``regrasp_lookahead: 5``, seed 0, DAgger on the optimum, needed
+1.15x the optimum's regrasps on 45 held-out starts with a gait without it and 1.05x
+with it.
 
 ``achieved``, ``room_on`` and ``room_back`` are 0 for an illegal action (``legal`` tells
 it apart). :class:`ObservationLayout` is the one place that knows where a part lies in
@@ -61,7 +71,7 @@ from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import rotation_room_of
 
 __all__ = ["ACTION_FEATURES", "GRASP_FIELDS", "OBSERVATION_MODES", "ObservationLayout",
-           "ObservationParts", "PARTS", "check_observation_mode"]
+           "ObservationParts", "PARTS", "check_observation_mode", "greedy_ranks"]
 
 OBSERVATION_MODES: tuple[str, ...] = ("box", "dict", "flat")
 PARTS: tuple[str, ...] = ("grasp", "actions", "window", "lines")
@@ -80,7 +90,61 @@ GRASP_FIELDS: tuple[str, ...] = (
     "cos_theta", "sin_theta", "achieved", "to_go")
 ACTION_FEATURES: tuple[str, ...] = ("legal", "rotation", "achieved", "room_on", "room_back")
 """The per-action features every dict observation has; ``opens`` and ``reach_1 ..
-reach_D`` follow with ``rotation_lookahead`` and ``regrasp_lookahead = D``."""
+reach_D``, ``reach_rank`` follow with ``rotation_lookahead`` and ``regrasp_lookahead =
+D``."""
+
+
+def greedy_ranks(reach: NDArray[np.floating], finishing: NDArray[np.bool_],
+                 legal: NDArray[np.bool_], rot_delta: NDArray[np.int64], turn_steps: int,
+                 none: int) -> NDArray[np.int64]:
+    """Every move's place in the greedy reading of the reach look-ahead, for ``B`` states.
+
+    The greedy reading (no learning; the benchmark's ``greedy-reach:D`` policy plays its
+    first move) orders the legal moves by, in turn: a rotation that reaches the turn
+    first; the least shortfall ``D - 1`` regrasps deep, then ``D - 2``, ... ``0``; a
+    regrasp before a rotation and a shorter rotation first; then the regrasps in action
+    order before the rotations in action order (every move gets its own place).
+
+    Parameters
+    ----------
+    reach
+        ``(B, A, D)``: each action's reach look-ahead (``regrasp_lookahead = D``), in the
+        gait model's action order (the ``2 R`` rotations first), as the envs write it:
+        shortfalls over ``turn_steps`` grid steps.
+    finishing
+        ``(B, A)``: the rotations that reach the turn.
+    legal
+        ``(B, A)``: the legal moves.
+    rot_delta
+        Signed grid steps of the ``2 R`` rotation actions.
+    turn_steps
+        ``K``, the turn in grid steps (> 0).
+    none
+        The shortfall (grid steps) written for "no such move", the largest.
+
+    Returns
+    -------
+    ``(B, A)`` int64: 0 for the move the greedy reading plays, 1, 2, ... for the next
+    legal moves, then the illegal moves (each ``A``).
+    """
+    B, A, D = reach.shape
+    R2 = int(np.size(rot_delta))
+    base = int(none) + 1
+    s = np.rint(np.asarray(reach, dtype=np.float64) * turn_steps).astype(np.int64)
+    key = (~np.asarray(finishing, dtype=bool)).astype(np.int64)
+    for j in range(D - 1, -1, -1):  # the deepest first
+        key = key * base + s[:, :, j].clip(0, none)
+    size = np.zeros(A, dtype=np.int64)
+    size[:R2] = np.abs(rot_delta)
+    key = key * (int(size.max()) + 1) + size
+    tie = np.empty(A, dtype=np.int64)  # the regrasps, then the rotations
+    tie[np.concatenate((np.arange(R2, A), np.arange(R2)))] = np.arange(A)
+    key = key * A + tie
+    key[~np.asarray(legal, dtype=bool)] = np.iinfo(np.int64).max
+    ranks = np.empty((B, A), dtype=np.int64)
+    np.put_along_axis(ranks, np.argsort(key, axis=1), np.arange(A)[None, :], axis=1)
+    ranks[~np.asarray(legal, dtype=bool)] = A
+    return ranks
 
 
 def check_observation_mode(value: Any) -> str:
@@ -155,7 +219,8 @@ class ObservationLayout:
         self.reach_depth = depth
         self.action_features: tuple[str, ...] = (
             ACTION_FEATURES + (("opens",) if lookahead else ())
-            + tuple(f"reach_{j + 1}" for j in range(depth)))
+            + tuple(f"reach_{j + 1}" for j in range(depth))
+            + (("reach_rank",) if depth else ()))
         shapes: list[tuple[str, tuple[int, ...]]] = [
             ("grasp", (_HEADER,)), ("actions", (n_actions, len(self.action_features))),
             ("window", (cells, cells))]
@@ -245,7 +310,9 @@ class ObservationParts:
         a_hi[:, col("achieved")] = hi[_ACHIEVED]
         a_hi[:, col("room_on")] = a_hi[:, col("room_back")] = R / self._K
         if layout.reach_depth:
-            a_hi[:, col("reach_1"):] = hi[layout.reach.start]
+            a_hi[:, col("reach_1"):col("reach_rank")] = hi[layout.reach.start]
+            # the look-ahead's "none", in grid steps (its bound, the largest entry)
+            self._none = int(round(float(hi[layout.reach.start]) * self._K))
         self._rotation = np.zeros(A, dtype=np.float32)
         self._rotation[:self._R2] = 1.0
         bounds = {"grasp": (lo[:_HEADER], hi[:_HEADER]), "actions": (a_lo, a_hi),
@@ -310,6 +377,12 @@ class ObservationParts:
             P2 = self._P2
             out[:, R2:, col:col + D] = reach[:, :P2 * D].reshape(B, P2, D)
             out[:, :R2, col:col + D] = reach[:, P2 * D:].reshape(B, R2, D)
+            finishing = np.zeros((B, lay.n_actions), dtype=bool)  # the rotations' achieved
+            finishing[:, :R2] = out[:, :R2, 2] * K >= K - 0.5  # (x K: grid steps)
+            ranks = greedy_ranks(out[:, :, col:col + D], finishing, legal > 0.5, d, K,
+                                 self._none)
+            out[:, :, col + D] = np.minimum(ranks, lay.n_actions - 1) / np.float32(
+                max(lay.n_actions - 1, 1))
         parts = {"grasp": box[:, :_HEADER].copy(), "actions": out,
                  "window": box[:, lay.window].reshape(B, lay.cells, lay.cells).copy()}
         if "lines" in lay.parts:

@@ -162,10 +162,65 @@ def test_a_bad_mode_is_refused_with_the_modes(bad):
 
 def test_layout_names_its_features_and_refuses_unknown_ones():
     lay = ObservationLayout(n_actions=10, cells=3, lookahead=4, reach=20)
-    assert lay.action_features == ACTION_FEATURES + ("opens", "reach_1", "reach_2")
-    assert [shape for _, shape in lay.parts.values()] == [(16,), (10, 8), (3, 3)]
-    assert lay.flat_size == 16 + 80 + 9
+    assert lay.action_features == ACTION_FEATURES + ("opens", "reach_1", "reach_2",
+                                                     "reach_rank")
+    assert [shape for _, shape in lay.parts.values()] == [(16,), (10, 9), (3, 3)]
+    assert lay.flat_size == 16 + 90 + 9
     with pytest.raises(GraspGaitInputError, match="feature='reach_3'.*reach_2"):
         lay.feature("reach_3")
-    with pytest.raises(GraspGaitInputError, match="flat_size|105"):
-        lay.unflatten(np.zeros(104, dtype=np.float32))
+    with pytest.raises(GraspGaitInputError, match="flat_size|115"):
+        lay.unflatten(np.zeros(114, dtype=np.float32))
+
+
+def _greedy_by_tuples(act, lay, model, K):
+    """The greedy reading written out with Python tuples (the order the benchmark's
+    ``greedy-reach`` documents): a finishing rotation, then the shortfalls deepest
+    first, then regrasp before rotation and the shorter rotation, then regrasps before
+    rotations in action order."""
+    R2, A = 2 * model.R, model.n_actions
+    cols = [lay.feature(f"reach_{j + 1}") for j in range(lay.reach_depth)][::-1]
+    legal = act[:, lay.feature("legal")] > 0.5
+    order = list(range(R2, A)) + list(range(R2))
+
+    def key(a):
+        finish = a < R2 and round(float(act[a, lay.feature("achieved")]) * K) >= K
+        size = abs(model.decode(None, a).delta) if a < R2 else 0  # thesis 5.2
+        return (not finish, *(round(float(act[a, c]) * K) for c in cols), size,
+                order.index(a))
+    return sorted((a for a in range(A) if legal[a]), key=key)
+
+
+@pytest.mark.parametrize("kw", [
+    {"object": "ellipse", "regrasp_lookahead": 3, "contact_model": "hand"},
+    {"object": "pentagon", "regrasp_lookahead": 2, "turn_deg": -90.0, "mu": 0.5},
+])
+def test_reach_rank_is_the_greedy_reading(kw):
+    """``reach_rank`` orders the legal moves as the greedy reading does, written here
+    with tuples; its least is the move the benchmark's greedy-reach policy plays, in
+    the single env and in every row of the batched one."""
+    from graspgait_env.benchmark.policies import greedy_reach_predictor
+
+    box_env = gym.make(ID, **kw)
+    pred = greedy_reach_predictor(box_env, depth=kw["regrasp_lookahead"])
+    checked = 0
+    for box, obs, _, info, u in _rollout(40, 5, **kw):
+        lay, model = u.layout, u.model
+        K = abs(model.turn_steps(kw.get("turn_deg", 360.0)))
+        act = obs["actions"]
+        expected = _greedy_by_tuples(act, lay, model, K)
+        rank = np.rint(act[:, lay.feature("reach_rank")] * (model.n_actions - 1))
+        assert [int(a) for a in np.argsort(rank, kind="stable")[:len(expected)]] == expected
+        assert (rank[~info["action_mask"]] == model.n_actions - 1).all()
+        box_env.unwrapped._set_state(u.state)  # the box env in the same state
+        assert pred(box, info["action_mask"]) == expected[0]
+        checked += 1
+    assert checked == 40
+    vec = gym.make_vec(ID, num_envs=3, vectorization_mode="vector_entry_point",
+                       observation_mode="dict", **kw)
+    sync = gym.vector.SyncVectorEnv([lambda: gym.make(ID, observation_mode="dict", **kw)] * 3)
+    (ov, _), (os_, _) = vec.reset(seed=9), sync.reset(seed=9)
+    for _ in range(10):
+        np.testing.assert_array_equal(ov["actions"], os_["actions"])
+        a = np.array([int(np.argmin(r[:, -1])) for r in ov["actions"]])
+        ov, *_ = vec.step(a)
+        os_, *_ = sync.step(a)
