@@ -829,8 +829,8 @@ def _add_train(sub: argparse._SubParsersAction) -> None:
                                        "train ellipse --set total_timesteps=100000",
                                        "train my_config.yaml --seeds 0-4 --ray",
                                        "config train ellipse > my_config.yaml"],
-                                      duration="seconds for smoke; 4-10 min for the bundled "
-                                      "thesis-object configs, 30 min for random; --seeds "
+                                      duration="seconds for smoke; 4-12 min for the bundled "
+                                      "configs (random, hexagon, general: imitation); --seeds "
                                       "runs one per seed (in parallel with --ray)"))
     p.add_argument("config", metavar="CONFIG", help="a bundled training config "
                    f"({', '.join(bundled_names('train'))}; `{PROG} config train NAME` prints "

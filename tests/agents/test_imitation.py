@@ -37,7 +37,8 @@ def test_the_block_is_checked_and_round_trips() -> None:
         load_train_config("general", ["algo=ppo", "policy=MlpPolicy",
                                       "features_extractor=null"])
     cfg = load_train_config("general")
-    assert cfg.imitation == Imitation(iterations=10, labels=4000, epochs=8, batch_size=256)
+    assert cfg.imitation == Imitation(iterations=10, labels=4000, epochs=8, batch_size=256,
+                                     teacher="greedy")
     again = TrainConfig(**yaml.safe_load(yaml.safe_dump(cfg.to_dict())))
     assert again == cfg
 
@@ -113,3 +114,24 @@ def test_the_general_recipe_trains_tiny_and_plays_an_object_file_it_never_saw(tm
     assert out["env_id"] == "GraspGait-v0" and out["object"] == "my_square"
     assert len(out["episodes"]) == 4
     assert 0.0 <= out["success_rate"] <= 1.0
+
+
+def test_the_greedy_teacher_keeps_the_greedy_move_unless_it_wastes_a_regrasp() -> None:
+    """Four states, 2 rotations then 3 regrasps: the greedy move (least rank among the
+    legal moves) is the label where the optimum has it or it is a rotation; a greedy
+    regrasp outside the optimum's set gives the set; no optimal move, no label."""
+    from graspgait_env.agents.imitation import greedy_labels
+
+    rank = np.array([[0.1, 0.5, 0.0, 0.3, 0.2],   # greedy: regrasp 2, optimal
+                     [0.0, 0.5, 0.2, 0.3, 0.4],   # greedy: rotation 0, not in the set
+                     [0.9, 0.5, 0.0, 0.3, 0.2],   # greedy: regrasp 2, not in the set
+                     [0.0, 0.5, 0.1, 0.3, 0.2]])  # no optimal move
+    masks = np.ones((4, 5), dtype=bool)
+    masks[2, 2] = False  # illegal: greedy is then regrasp 4 (rank 0.2)
+    optimal = np.array([[0, 0, 1, 1, 0], [0, 0, 0, 1, 0], [0, 1, 0, 1, 0], [0, 0, 0, 0, 0]],
+                       dtype=bool)
+    got = greedy_labels(rank, masks, optimal, rotations=2)
+    np.testing.assert_array_equal(got, np.array(
+        [[0, 0, 1, 0, 0], [1, 0, 0, 0, 0], [0, 1, 0, 1, 0], [0, 0, 0, 0, 0]], dtype=bool))
+    with pytest.raises(GraspGaitInputError, match=r"imitation\.teacher='best'"):
+        Imitation(teacher="best")
