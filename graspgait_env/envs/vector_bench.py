@@ -111,7 +111,15 @@ def bench_rows(repeat: int) -> list[BenchRow]:
               batched_steps_per_s(rn, steps, r, env_id="GraspGaitRandom-v0", mode="sync",
                                   level=1)) for r in range(rounds)]
     rb, rs = (max(rates) for rates in zip(*pairs, strict=True))
+    # the batch of one: why the single env keeps its own scalar step (envs/rows.py)
+    ones = [(batched_steps_per_s(1, 20_000, seed=r), graspgait_steps_per_s(20_000, r))
+            for r in range(rounds)]
+    b1, s1 = (max(rates) for rates in zip(*ones, strict=True))
     return [
+        BenchRow("GraspGait-v0 single env / batched N=1", s1 / b1, "x", "", None,
+                 f"{s1:.0f} against {b1:.0f} steps/s: the single env's scalar step over "
+                 f"the batched step with one row; best of {rounds} x 20000 steps, same "
+                 "process"),
         BenchRow(f"GraspGaitRandom-v0 batched N={rn} / SyncVectorEnv", rb / rs, "x", "", None,
                  f"{rb:.0f} against {rs:.0f} env-steps/s; level 1, masked random actions, "
                  f"best of {rounds} x {steps} steps of {rn}, same process"),
