@@ -145,16 +145,16 @@ def greedy_labels(rank: np.ndarray, masks: np.ndarray, optimal: np.ndarray,
     return out
 
 
-def _greedy_rank(obs: Any, venv: Any) -> tuple[np.ndarray, int]:
-    """The ``reach_rank`` column of a batch of observations and the rotation count."""
+def _rank_column(obs: Any, venv: Any) -> tuple[int, int]:
+    """Where the greedy teacher reads: the ``reach_rank`` column of the ``actions`` part
+    and the rotation count ``2 R`` (the hand's, the same for every object), checked once."""
     u = venv.get_attr("unwrapped", [0])[0]
     if not isinstance(obs, dict) or "reach_rank" not in u.layout.action_features:
         raise GraspGaitInputError(
             "imitation.teacher='greedy': reads the greedy reading's move from the dict "
             "observation's reach_rank; set env_kwargs observation_mode: dict and "
             "regrasp_lookahead: 1 or more")
-    return (np.asarray(obs["actions"])[:, :, u.layout.feature("reach_rank")],
-            2 * int(u.model.R))
+    return u.layout.feature("reach_rank"), 2 * int(u.model.R)
 
 
 def _obs_rows(obs: Any, keep: np.ndarray) -> Any:
@@ -214,6 +214,8 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
     total = config.iterations * config.labels
     bar = tqdm(total=total, desc="imitation", unit="label", disable=not progress)
     obs = venv.reset()
+    if config.teacher == "greedy":
+        rank_col, rotations = _rank_column(obs, venv)
     try:
         for it in range(config.iterations):
             got = 0
@@ -221,8 +223,8 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
                 masks = np.stack(venv.env_method("action_masks"))
                 teach = np.stack(venv.env_method("optimal_moves"))
                 if config.teacher == "greedy":
-                    rank, rotations = _greedy_rank(obs, venv)
-                    teach = greedy_labels(rank, masks, teach, rotations)
+                    teach = greedy_labels(np.asarray(obs["actions"])[:, :, rank_col], masks,
+                                          teach, rotations)
                 keep = teach.any(axis=1)
                 if keep.any():
                     obs_parts.append(_obs_rows(obs, keep))

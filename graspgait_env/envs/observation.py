@@ -129,6 +129,7 @@ def greedy_ranks(reach: NDArray[np.floating], finishing: NDArray[np.bool_],
     """
     B, A, D = reach.shape
     R2 = int(np.size(rot_delta))
+    illegal = ~np.asarray(legal, dtype=bool)
     base = int(none) + 1
     s = np.rint(np.asarray(reach, dtype=np.float64) * turn_steps).astype(np.int64)
     key = (~np.asarray(finishing, dtype=bool)).astype(np.int64)
@@ -140,10 +141,10 @@ def greedy_ranks(reach: NDArray[np.floating], finishing: NDArray[np.bool_],
     tie = np.empty(A, dtype=np.int64)  # the regrasps, then the rotations
     tie[np.concatenate((np.arange(R2, A), np.arange(R2)))] = np.arange(A)
     key = key * A + tie
-    key[~np.asarray(legal, dtype=bool)] = np.iinfo(np.int64).max
+    key[illegal] = np.iinfo(np.int64).max
     ranks = np.empty((B, A), dtype=np.int64)
     np.put_along_axis(ranks, np.argsort(key, axis=1), np.arange(A)[None, :], axis=1)
-    ranks[~np.asarray(legal, dtype=bool)] = A
+    ranks[illegal] = A
     return ranks
 
 
