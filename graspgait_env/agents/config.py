@@ -51,6 +51,9 @@ VEC_ENVS = ("dummy", "subproc", "batched")
 (:mod:`graspgait_env.agents.vec_env`; ``GraspGait-v0`` and ``GraspGaitRandom-v0`` without
 wrappers only, same transitions)."""
 ACTIVATIONS = ("tanh", "relu")
+_OWN_POLICY_KWARGS = {"net_arch": "net_arch", "activation_fn": "activation",
+                      "features_extractor_class": "features_extractor",
+                      "features_extractor_kwargs": "features_extractor_kwargs"}
 
 
 class _Loader(yaml.SafeLoader):
@@ -168,10 +171,10 @@ class TrainConfig:
     leaves them out."""
     policy: str = "MlpPolicy"
     """SB3's ``MlpPolicy``, or the import path of a policy class: with ``algo:
-    maskable_ppo``, ``graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` (SB3's network
-    plus a
-    regrasp scorer shared by every regrasp action; needs ``features_extractor:
-    graspgait_env.agents.policies:GraspMapExtractor`` with ``workspace_widths``)."""
+    maskable_ppo``, ``graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` (SB3's
+    network plus one scorer shared by every move; needs ``features_extractor:
+    graspgait_env.agents.policies:PartsExtractor`` and ``env_kwargs`` ``observation_mode:
+    dict``)."""
     net_arch: list[int] | dict[str, list[int]] = field(default_factory=lambda: [64, 64])
     """Hidden layer widths of the policy and value networks (a list: shared sizes, separate
     networks; or ``{pi: [...], vf: [...]}``)."""
@@ -181,6 +184,11 @@ class TrainConfig:
     """Import path of an SB3 ``BaseFeaturesExtractor`` subclass, or None (flatten)."""
     features_extractor_kwargs: dict[str, Any] = field(default_factory=dict)
     """Its keyword arguments."""
+    policy_kwargs: dict[str, Any] = field(default_factory=dict)
+    """Further keyword arguments of the policy class (SB3's ``policy_kwargs``), e.g.
+    ``{scorer_arch: [64], scorer_context: 32}`` for ``MaskableRegraspScorerPolicy``; the
+    network and the extractor have their own fields (``net_arch``, ``activation``,
+    ``features_extractor``, ``features_extractor_kwargs``), refused here."""
     n_envs: int = 8
     """Parallel environments."""
     vec_env: str = "dummy"
@@ -284,6 +292,16 @@ class TrainConfig:
                 f"features_extractor_kwargs={self.features_extractor_kwargs!r}: must be a "
                 "mapping, e.g. {}")
         put("features_extractor_kwargs", dict(self.features_extractor_kwargs))
+        if not isinstance(self.policy_kwargs, Mapping):
+            raise GraspGaitInputError(
+                f"policy_kwargs={self.policy_kwargs!r}: must be a mapping, e.g. "
+                "{scorer_arch: [64]}")
+        own = sorted(set(self.policy_kwargs) & set(_OWN_POLICY_KWARGS))
+        if own:
+            raise GraspGaitInputError(
+                f"policy_kwargs {own}: set by their own fields; use "
+                + ", ".join(_OWN_POLICY_KWARGS[k] for k in own) + " instead")
+        put("policy_kwargs", dict(self.policy_kwargs))
         put("n_envs", check_count("n_envs", self.n_envs, 1, 8))
         put("vec_env", _check_str("vec_env", self.vec_env, VEC_ENVS))
         put("n_steps", check_count("n_steps", self.n_steps, 1, 256))

@@ -1,10 +1,22 @@
-"""Policy networks for the GraspGait observation: convolutions over the grasp map's views,
-and a policy that scores every regrasp with one shared network.
+"""Policy networks for the GraspGait observation: a policy that scores every move with
+one shared network over the env's named parts, and the extractor it reads them with.
 
-:class:`GraspMapExtractor` is an SB3 features extractor (``features_extractor:
-graspgait_env.agents.policies:GraspMapExtractor`` in a training config). It splits the flat
-observation at :class:`graspgait_env.envs.observation.ObservationLayout`'s slices and reads
-each part with the structure it has:
+**The policy design** (every learned agent that is not a plain MLP): MaskablePPO's
+:class:`MaskableRegraspScorerPolicy` over :class:`PartsExtractor`, on an env with
+``observation_mode: dict`` (the named parts of
+:mod:`graspgait_env.envs.observation`): a global context and one small network,
+shared by every move, that scores each move from its row of the env's ``actions``
+part (``configs/train/general.yaml``).
+
+:class:`GraspMapExtractor` is **retired for training**: ``graspgait train`` refuses a
+config that names it (:func:`graspgait_env.agents.train.extractor_kwargs`, the error
+names the fix). It stays only so that models saved with it (graspgait_env 0.1 and 0.2,
+``tests/agents/test_shipped.py``) load and act as they did. What it computed from the
+flat observation, the env now gives per move in the named parts (legality, the turn
+achieved, the rotation room towards and against the goal after the move, the reach
+look-ahead; :data:`~graspgait_env.envs.observation.ACTION_FEATURES`). It splits the
+flat observation at :class:`graspgait_env.envs.observation.ObservationLayout`'s slices
+and reads each part with the structure it has:
 
 - the **header** (held fingers, workspace positions, contact and object angles, turn
   achieved and to go: 16 numbers) and the **legal-move mask** (one entry per action)
@@ -15,71 +27,25 @@ each part with the structure it has:
   (both contacts move by the same angle, thesis 5.2), so the same local pattern means
   the same thing wherever it lies in the window;
 - the **map lines** (``map_lines=True``: the map's row and column through the grasp,
-  ``2 x n`` over the whole circle) go through a 1-D convolution with circular padding:
-  a rotation by ``d`` grid steps shifts both lines by ``d``, so a shift-equivariant
-  reading of them generalises across where the regrasps open.
+  ``2 x n`` over the whole circle) go through a 1-D convolution with circular padding.
 
-With ``conv=False`` the window and the lines pass through flat instead (the
-``MlpPolicy`` input, unchanged), for the finishing rotations alone.
+With ``conv=False`` the window and the lines pass through flat instead. Its optional
+features (a saved model's keyword arguments say which it uses): the **finishing
+rotations** (``turn_steps`` and ``rotations``: per rotation towards the goal, 1 when it
+is legal and reaches the turn), the **shortfall code** (``shortfall_bins``: the turn
+still to go after the longest legal rotation, as a thermometer code), the
+**forward-gait features** (``workspace_widths``: thesis 6.3.1's two choices, the
+longest legal rotation towards the goal and the room each regrasp leaves), the
+**regrasp block** (``regrasp_block``: :data:`REGRASP_CHANNELS` entries per regrasp,
+:meth:`GraspMapExtractor.regrasp_block`) and the **action block** (``reach_depth``:
+every move with the env's reach look-ahead, :meth:`GraspMapExtractor.action_block`).
+Entries after the lines (``tail``) pass through unchanged.
 
-The **finishing rotations** (``turn_steps`` and ``rotations`` given): one entry per
-rotation towards the goal, ``a = 0 .. R-1`` (rotate by ``a + 1`` grid steps, the
-*Action Space* of ``GraspGait-v0``), 1 when that rotation is legal now (the mask) and
-reaches the requested turn (``a + 1 >= `` the turn to go in grid steps, header entry
-15 times ``abs(turn_steps)``), else 0. It is a function of the observation alone (mask
-and turn to go), computed exactly rather than learned: measured on the ellipse
-(``agents/models/ellipse.md``), agents that played their learned gait cycle on from a
-grasp whose rotation already reaches the turn spent two regrasps there (away from the
-goal and back) in nearly every episode, most of their regrasps beyond the optimum.
-
-The **shortfall code** (``shortfall_bins`` given, with the finishing rotations): the
-turn still to go after the longest legal rotation towards the goal (grid steps, 0 when
-it reaches the turn; the mask and the turn to go of the observation), as a thermometer
-code of ``shortfall_bins`` entries (entry ``j`` is 1 when the shortfall exceeds ``j``
-bin widths of ``abs(turn_steps) / shortfall_bins`` grid steps), so that a linear layer
-reads any step function of it: the regrasps still needed rise in steps of the turn one
-regrasp buys (about 45° on the circle), and a policy that reads the shortfall as one
-number must learn that staircase itself.
-The **forward-gait features** (``workspace_widths`` given, with the finishing
-rotations): the two choices of thesis 6.3.1's forward (staircase) gait, as inputs per
-action, computed from the observation (the held fingers, their workspace positions and
-the mask): a one-hot of the longest legal rotation towards the goal (over its ``R``
-rotations), and for each regrasp action the room for a rotation towards the goal that
-the grasp it makes would have (the rotation room of thesis 5.2, ``min(W - 1 - p)`` over
-the new pair counter-clockwise, ``min(p)`` clockwise; over ``R``; 0 where illegal),
-and, with ``best_regrasp``, a one-hot of the legal regrasps with the most room.
-With a linear policy head on them (``net_arch: {pi: [], vf: [...]}``) a logit can be a
-weight times one of these entries, which a hidden layer narrower than the action space
-cannot pass through for every action; the weights are learned, nothing forces the
-forward gait.
-The **regrasp block** (``regrasp_block``, set by :class:`MaskableRegraspScorerPolicy`):
-for each regrasp action, :data:`REGRASP_CHANNELS` entries computed from the observation
-(:meth:`GraspMapExtractor.regrasp_block`), which that policy's shared scorer reads, one
-regrasp at a time; they follow every other feature and the policy keeps them out of
-its MLPs.
-The **action block** (``reach_depth``, with the regrasp block): the block then covers
-every action, rotations included, and adds to each action's entries the env's reach
-look-ahead (``regrasp_lookahead``: how far short of the turn the best chain of a few
-more regrasps after that move stays, a depth-limited search of the grasp map), so the
-shared scorer prices every move by what it leads to (:meth:`GraspMapExtractor.
-action_block`).
-Entries after the lines (``tail``, e.g. an opt-in field the env appends there) pass
-through unchanged too.
-
-**Where the parts lie is the env's.** A training config gives choices and the switches
-of :data:`FEATURE_SWITCHES` (``finishing_rotations``, ``forward_gait``,
-``action_block``), never an offset: the trainer fills in ``cells``, ``line_cells``,
-``tail``, ``turn_steps``, ``rotations``, ``workspace_widths`` and ``reach_depth``
-(:data:`ENV_GEOMETRY`) from the env's
-:class:`~graspgait_env.envs.observation.ObservationLayout` and gait model
-(:func:`extractor_kwargs_for`), and the saved model keeps them.
-
-The features are the concatenation (header and mask, window features, line features,
-tail, finishing rotations); SB3's ``net_arch`` MLP heads sit on top as with
-``MlpPolicy``. The class
-and its keyword arguments are saved in the model zip by SB3 (``policy_kwargs``) and
-rebuilt on load, so a model trained with it loads with :func:`graspgait_env.agents.card.load_agent`
-as any other (``tests/agents/test_policies.py``).
+Its features are the concatenation (header and mask, window features, line features,
+tail, finishing rotations, the blocks). Every class here and its keyword arguments are
+saved in the model zip by SB3 (``policy_kwargs``) and rebuilt on load, so a model loads
+with :func:`graspgait_env.agents.card.load_agent` as any other
+(``tests/agents/test_policies.py``, ``tests/agents/test_parts_policy.py``).
 """
 
 from __future__ import annotations
@@ -98,9 +64,8 @@ from torch import nn
 from graspgait_env.envs.observation import ObservationLayout
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["ENV_GEOMETRY", "FEATURE_SWITCHES", "REGRASP_CHANNELS", "GraspMapExtractor",
-           "MaskableRegraspScorerPolicy", "PartsExtractor", "extractor_kwargs_for",
-           "layout_of"]
+__all__ = ["REGRASP_CHANNELS", "GraspMapExtractor", "MaskableRegraspScorerPolicy",
+           "PartsExtractor", "layout_of"]
 
 REGRASP_CHANNELS = 9
 """Entries per regrasp action in :meth:`GraspMapExtractor.regrasp_block`."""
@@ -136,79 +101,6 @@ def layout_of(observation_space: gym.spaces.Box, cells: int, line_cells: int,
             "map_window_cells and, with map_lines, its grid size n (e.g. cells: 36, "
             "line_cells: 180)")
     return ObservationLayout(n_actions, cells, line_cells)
-
-
-ENV_GEOMETRY: tuple[str, ...] = ("cells", "line_cells", "tail", "turn_steps", "rotations",
-                                 "workspace_widths", "reach_depth")
-""":class:`GraspMapExtractor` keywords that describe the env, not a choice: filled in from
-the env's :class:`~graspgait_env.envs.observation.ObservationLayout` and gait model by
-:func:`extractor_kwargs_for`, so no training config gives them."""
-
-FEATURE_SWITCHES: tuple[str, ...] = ("finishing_rotations", "forward_gait", "action_block")
-"""The training config's switches for the features that need the env's geometry:
-``finishing_rotations`` (``turn_steps`` and ``rotations``), ``forward_gait`` (also
-``workspace_widths``: the forward-gait features, and the regrasp block of
-:class:`MaskableRegraspScorerPolicy`), ``action_block`` (also ``reach_depth``: the env's
-``regrasp_lookahead``)."""
-
-
-def extractor_kwargs_for(env: gym.Env, kwargs: dict[str, Any]) -> dict[str, Any]:
-    """:class:`GraspMapExtractor`'s keyword arguments for ``env`` from a training config's
-    ``features_extractor_kwargs``.
-
-    The config gives choices (``conv``, ``shortfall_bins``, ``best_regrasp``,
-    ``reach_relative``, ``reach_best``, the layer widths) and the switches of
-    :data:`FEATURE_SWITCHES`; where a part of the observation lies and the gait model's
-    sizes (:data:`ENV_GEOMETRY`) come from the env: ``cells`` its map window,
-    ``line_cells`` its map lines' length (0 without ``map_lines``), ``tail`` the entries
-    after them (``rotation_lookahead`` and ``regrasp_lookahead``), ``turn_steps`` the
-    signed turn in grid steps, ``rotations`` ``model.R``, ``workspace_widths``
-    ``model.ws_width``, ``reach_depth`` the reach look-ahead's depth. A geometry keyword
-    the config still gives (an older config) must equal the env's.
-
-    Raises
-    ------
-    GraspGaitInputError
-        A geometry keyword that differs from the env's, a switch that is not True or
-        False, or ``action_block`` on an env without ``regrasp_lookahead``.
-    """
-    u = env.unwrapped
-    lay, model = u.layout, u.model
-    switches = {}
-    for name in FEATURE_SWITCHES:
-        value = kwargs.get(name, False)
-        if not isinstance(value, bool):
-            raise GraspGaitInputError(f"features_extractor_kwargs {name}={value!r}: must be "
-                                      "true or false")
-        switches[name] = value
-    forward = switches["forward_gait"] or switches["action_block"]
-    finishing = switches["finishing_rotations"] or forward
-    if switches["action_block"] and not lay.reach_depth:
-        raise GraspGaitInputError(
-            "features_extractor_kwargs action_block=true: the env has no reach look-ahead; "
-            "set env_kwargs regrasp_lookahead (e.g. 3)")
-    env_values: dict[str, Any] = {
-        "cells": lay.cells, "line_cells": (lay.lines.stop - lay.lines.start) // 2,
-        "tail": lay.size - lay.lines.stop,
-        "turn_steps": int(model.turn_steps(u.config.turn_deg)), "rotations": int(model.R),
-        "workspace_widths": [int(w) for w in model.ws_width], "reach_depth": lay.reach_depth}
-    out = {k: v for k, v in kwargs.items() if k not in FEATURE_SWITCHES}
-    for key, value in env_values.items():
-        if key in out:
-            given = list(out[key]) if key == "workspace_widths" else out[key]
-            if given != value:
-                raise GraspGaitInputError(
-                    f"features_extractor_kwargs {key}={out[key]!r}: this env's is {value!r}; "
-                    "leave it out (it is read from the env's ObservationLayout and gait "
-                    "model)")
-    out.update({k: env_values[k] for k in ("cells", "line_cells", "tail")})
-    if finishing:
-        out.update(turn_steps=env_values["turn_steps"], rotations=env_values["rotations"])
-    if forward:
-        out["workspace_widths"] = env_values["workspace_widths"]
-    if switches["action_block"]:
-        out["reach_depth"] = env_values["reach_depth"]
-    return out
 
 
 def _most_room(room: torch.Tensor) -> torch.Tensor:
@@ -708,33 +600,30 @@ class _ScoredActionNet(nn.Module):
 class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     """sb3-contrib's maskable actor-critic with a **shared regrasp scorer**.
 
-    ``policy: graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` in a training config (with
-    ``algo: maskable_ppo`` and either ``features_extractor:
-    graspgait_env.agents.policies:PartsExtractor`` on the env's named parts,
-    ``observation_mode: dict``, where every action is scored from the env's per-action
-    features; or ``features_extractor: graspgait_env.agents.policies:GraspMapExtractor``
-    with ``forward_gait: true`` on the box observation, where the extractor computes the
-    regrasp block; the policy sets its ``regrasp_block``).
+    ``policy: graspgait_env.agents.policies:MaskableRegraspScorerPolicy`` in a training
+    config, with ``algo: maskable_ppo`` and ``features_extractor:
+    graspgait_env.agents.policies:PartsExtractor`` on the env's named parts
+    (``observation_mode: dict``), where every action is scored from the env's per-action
+    features. (Models saved with the retired :class:`GraspMapExtractor`, whose regrasp
+    block the policy switched on, load too.)
 
     Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent)
-    and, for a regrasp action ``2R + 2q + l`` (thesis 4.2's move: the free finger to
-    workspace position ``q``, held finger ``l`` lifted), plus a score of that regrasp:
-    one MLP (``scorer_arch``), the same for every regrasp, over the regrasp's entries of
-    :meth:`GraspMapExtractor.regrasp_block` (its legality, the rotation room towards
-    and away from the goal of the grasp it makes, positions, whether its neighbouring
-    regrasps are legal, whether it has the most room) and a ``scorer_context``-wide
-    ReLU projection of the policy latent (what the state asks for). The value head is
-    SB3's.
-    With the extractor's ``reach_depth`` every action, rotations included, is scored
-    the same way from :meth:`GraspMapExtractor.action_block` (its regrasp entries, the
-    rotation's size and direction, and the env's reach look-ahead of that move).
+    plus a score of that move: one MLP (``scorer_arch``), the same for every move, over
+    the move's row of :class:`PartsExtractor`'s action block (the env's per-action
+    features of thesis 4.2's moves, rotations and regrasps alike: legality, the turn
+    achieved and the rotation room towards and against the goal after it, the
+    look-aheads' entries, each also against the best legal move) and a
+    ``scorer_context``-wide ReLU projection of the policy latent (what the state asks
+    for). The value head is SB3's. (With the retired :class:`GraspMapExtractor` the
+    scored rows are its :meth:`~GraspMapExtractor.regrasp_block` or
+    :meth:`~GraspMapExtractor.action_block`.)
 
-    Why: with a flat head every regrasp action has its own output weights, so what the
-    agent learns of a regrasp at one workspace position (e.g. that one leaving no
-    rotation room towards the goal loses a regrasp) does not carry to the same kind of
-    regrasp at another; the shared scorer prices every regrasp by the same function of
-    what it does. It only re-weights legal moves, computed from the observation; it
-    never sees the optimum's regrasps to go. Measured in ``agents/models/*.md``.
+    Why: with a flat head every action has its own output weights, so what the agent
+    learns of a regrasp at one workspace position (e.g. that one leaving no rotation
+    room towards the goal loses a regrasp) does not carry to the same kind of regrasp at
+    another; the shared scorer prices every move by the same function of what it does.
+    It only re-weights legal moves, computed from the observation; it never sees the
+    optimum's regrasps to go. Measured in ``agents/models/*.md``.
 
     Parameters
     ----------
@@ -753,10 +642,7 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
             raise GraspGaitInputError(
                 f"policy MaskableRegraspScorerPolicy with features_extractor {extractor!r}: "
                 "needs graspgait_env.agents.policies:PartsExtractor (the env's per-action "
-                "features, observation_mode: dict) or "
-                "graspgait_env.agents.policies:GraspMapExtractor with "
-                "features_extractor_kwargs forward_gait: true (it computes the regrasp "
-                "block)")
+                "features; env_kwargs observation_mode: dict)")
         if issubclass(extractor, GraspMapExtractor):
             kwargs["features_extractor_kwargs"] = {
                 **(kwargs.get("features_extractor_kwargs") or {}), "regrasp_block": True}

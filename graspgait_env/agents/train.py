@@ -177,20 +177,30 @@ def _algo_class(algo: str) -> type:
 
 
 def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
-    """The keyword arguments ``config``'s features extractor is built with: the config's
-    own, and for :class:`~graspgait_env.agents.policies.GraspMapExtractor` the geometry
-    of the observation, which comes from the env (its ``ObservationLayout``, through
-    :func:`~graspgait_env.agents.policies.extractor_kwargs_for`), never from the config."""
-    from graspgait_env.agents.policies import GraspMapExtractor, extractor_kwargs_for
+    """The keyword arguments ``config``'s features extractor is built with (the config's
+    own).
+
+    Raises
+    ------
+    GraspGaitInputError
+        ``features_extractor`` is the retired
+        :class:`~graspgait_env.agents.policies.GraspMapExtractor` (it only loads models
+        saved with it); the message names the named-parts design that replaces it.
+    """
+    from graspgait_env.agents.policies import GraspMapExtractor
 
     kwargs = dict(config.features_extractor_kwargs)
     if config.features_extractor is None:
         return kwargs
     extractor = import_object(config.features_extractor, "features_extractor")
     if isinstance(extractor, type) and issubclass(extractor, GraspMapExtractor):
-        probe = make_env(config.env_id, config.env_kwargs)
-        kwargs = extractor_kwargs_for(probe, kwargs)
-        probe.close()
+        raise GraspGaitInputError(
+            f"features_extractor={config.features_extractor!r}: retired for training (it "
+            "only loads the models saved with it); train on the env's named parts: "
+            "env_kwargs observation_mode: dict, features_extractor: "
+            "graspgait_env.agents.policies:PartsExtractor, policy: "
+            "graspgait_env.agents.policies:MaskableRegraspScorerPolicy, as "
+            "configs/train/general.yaml does")
     return kwargs
 
 
@@ -206,6 +216,7 @@ def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = Non
         policy_kwargs["features_extractor_class"] = import_object(config.features_extractor,
                                                                   "features_extractor")
         policy_kwargs["features_extractor_kwargs"] = extractor_kwargs(config)
+    policy_kwargs.update(config.policy_kwargs)
     lr: Any = config.learning_rate
     if config.lr_schedule == "linear":
         lr0 = config.learning_rate

@@ -65,6 +65,9 @@ def test_config_from_a_path(tmp_path):
     (["env_kwargs=3", "env_kwargs.mu=0.7"], r"env_kwargs is 3, not a mapping"),
     (["net_arch=[64"], r"the value is not valid YAML"),
     (["wrappers=[nodots]"], r"wrappers\[0\]='nodots': give an import path"),
+    (["policy_kwargs=3"], r"policy_kwargs=3: must be a mapping"),
+    (["policy_kwargs={net_arch: [8]}"], r"policy_kwargs \['net_arch'\]: set by their own "
+                                        r"fields; use net_arch instead"),
 ])
 def test_bad_overrides_name_the_field_and_the_fix(overrides, match):
     with pytest.raises(GraspGaitInputError, match=match):

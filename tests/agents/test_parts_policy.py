@@ -88,3 +88,18 @@ def test_it_trains_saves_loads_and_evaluates_batched(tmp_path):
     assert res["n_episodes"] == len(res["episodes"]) == 6
     assert res["illegal_action_rate"] == 0.0
     assert res["env_kwargs"]["observation_mode"] == "dict"
+
+
+def test_policy_kwargs_reach_the_scorer_and_are_saved(tmp_path):
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                      "policy_kwargs={scorer_arch: [8, 8], scorer_context: 4}"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    assert model.policy.scorer_arch == [8, 8] and model.policy.scorer_context == 4
+    widths = [m.out_features for m in model.policy.mlp_extractor.scorer
+              if isinstance(m, torch.nn.Linear)]
+    assert widths == [8, 8, 1]
+    path = save_agent(model, tmp_path / "k.zip", {"algo": cfg.algo, "env_id": cfg.env_id,
+                                                  "env_kwargs": cfg.env_kwargs})
+    loaded, _ = load_agent(path)
+    assert loaded.policy.scorer_arch == [8, 8]

@@ -1,4 +1,5 @@
-"""The grasp-map features extractor: layout, shapes, save/load with the model zip."""
+"""The grasp-map features extractor, retired for training: layout, shapes, save/load of
+the models saved with it, and the refusal to train a new one."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from graspgait_env.errors import GraspGaitInputError
 from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
 _EXTRACTOR = "graspgait_env.agents.policies:GraspMapExtractor"
+_PARTS = "graspgait_env.agents.policies:PartsExtractor"
 
 
 def _env(**kw):
@@ -67,15 +69,26 @@ def test_without_lines_the_extractor_has_no_line_branch():
     assert ext.features_dim == ext.layout.window.start + 64
 
 
-def test_model_with_the_extractor_saves_and_loads_with_identical_actions(tmp_path):
+def test_training_with_the_retired_extractor_is_refused_with_the_fix(tmp_path):
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", f"features_extractor={_EXTRACTOR}"])
+    with pytest.raises(GraspGaitInputError, match=r"GraspMapExtractor'.*retired for training.*"
+                       r"observation_mode: dict.*PartsExtractor"):
+        build_model(cfg, make_vec_env_for(cfg))
+
+
+def test_a_model_with_the_extractor_saves_and_loads_with_identical_actions(tmp_path):
+    """Built as graspgait_env 0.2 built it (SB3's policy_kwargs), a model with the
+    retired extractor still saves and loads with the same weights and actions."""
+    from sb3_contrib import MaskablePPO
+
     torch.set_num_threads(1)
     cfg = load_train_config("smoke", [
-        f"run_root={tmp_path}", "env_kwargs.map_lines=true", "env_kwargs.map_window_cells=12",
-        f"features_extractor={_EXTRACTOR}",
-        "features_extractor_kwargs={cells: 12, line_cells: 180}"])
-    model = build_model(cfg, make_vec_env_for(cfg))
+        f"run_root={tmp_path}", "env_kwargs.map_lines=true", "env_kwargs.map_window_cells=12"])
+    model = MaskablePPO("MlpPolicy", make_vec_env_for(cfg), n_steps=64, batch_size=32,
+                        policy_kwargs={"features_extractor_class": GraspMapExtractor,
+                                       "features_extractor_kwargs": {"cells": 12,
+                                                                     "line_cells": 180}})
     model.learn(128)
-    assert isinstance(model.policy.features_extractor, GraspMapExtractor)
     path = save_agent(model, tmp_path / "m.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
     loaded, _ = load_agent(path)
     assert isinstance(loaded.policy.features_extractor, GraspMapExtractor)
@@ -205,63 +218,9 @@ def test_forward_gait_features_need_the_hand_widths():
         GraspMapExtractor(env.observation_space, workspace_widths=[46, 46, 46])
 
 
-# the geometry the configs of graspgait_env 0.2 gave GraspMapExtractor by hand, until the
-# trainer read it from the env: their env and extractor keywords (the models trained with
-# them load with this extractor) and the hand-written figures
-_HAND_WRITTEN = {
-    "ellipse": ("GraspGait-v0",
-                {"object": "ellipse", "mu": 0.7, "contact_model": "hand",
-                 "rotation_lookahead": True, "map_lines": False, "map_window_cells": 1},
-                {"conv": False, "finishing_rotations": True},
-                {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
-                 "rotations": 45}),
-    "hexagon": ("GraspGait-v0",
-                {"object": "hexagon", "mu": 0.7, "contact_model": "hand",
-                 "rotation_lookahead": True, "map_lines": False, "map_window_cells": 1},
-                {"conv": False, "forward_gait": True},
-                {"cells": 1, "line_cells": 0, "conv": False, "tail": 90, "turn_steps": 180,
-                 "rotations": 45, "workspace_widths": [46, 46, 46]}),
-    "random": ("GraspGaitRandom-v0",
-               {"level": 1, "map_lines": False, "map_window_cells": 1,
-                "regrasp_lookahead": 3},
-               {"conv": False, "action_block": True, "reach_relative": True,
-                "reach_best": True},
-               {"cells": 1, "line_cells": 0, "conv": False, "tail": 546, "turn_steps": 180,
-                "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 3,
-                "reach_relative": True, "reach_best": True}),
-}
-
-
-@pytest.mark.parametrize("name", sorted(_HAND_WRITTEN))
-def test_the_env_gives_the_geometry_the_configs_gave_by_hand(name):
-    from graspgait_env.agents.envs import make_env
-    from graspgait_env.agents.policies import extractor_kwargs_for
-
-    env_id, env_kwargs, choices, by_hand = _HAND_WRITTEN[name]
-    env = make_env(env_id, env_kwargs)
-    assert extractor_kwargs_for(env, choices) == by_hand
-
-
-def test_no_bundled_config_gives_an_observation_offset():
-    from graspgait_env.agents.policies import ENV_GEOMETRY
+def test_no_bundled_config_trains_the_retired_extractor():
     from graspgait_env.resources import bundled_names
 
     for name in bundled_names("train"):
-        kw = load_train_config(name).features_extractor_kwargs
-        assert not set(kw) & set(ENV_GEOMETRY), (name, kw)
-
-
-def test_the_geometry_follows_the_env_and_a_wrong_one_is_refused():
-    from graspgait_env.agents.policies import extractor_kwargs_for
-
-    env = _env(turn_deg=-90.0, map_lines=True, regrasp_lookahead=2, map_window_cells=9)
-    kw = extractor_kwargs_for(env, {"forward_gait": True, "action_block": True})
-    assert kw == {"cells": 9, "line_cells": 180, "tail": 182 * 2, "turn_steps": -45,
-                  "rotations": 45, "workspace_widths": [46, 46, 46], "reach_depth": 2}
-    with pytest.raises(GraspGaitInputError, match=r"tail=90: this env's is 364.*leave it out"):
-        extractor_kwargs_for(env, {"tail": 90})
-    assert extractor_kwargs_for(env, {"tail": 364})["tail"] == 364  # an older config
-    with pytest.raises(GraspGaitInputError, match="action_block=true.*regrasp_lookahead"):
-        extractor_kwargs_for(_env(), {"action_block": True})
-    with pytest.raises(GraspGaitInputError, match="forward_gait='yes'"):
-        extractor_kwargs_for(_env(), {"forward_gait": "yes"})
+        cfg = load_train_config(name)
+        assert cfg.features_extractor in (None, _PARTS), (name, cfg.features_extractor)

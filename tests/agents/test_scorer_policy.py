@@ -20,13 +20,22 @@ from tests.agents.helpers import assert_same_greedy_actions, gait_extractor
 
 _SCORER = [
     "policy=graspgait_env.agents.policies:MaskableRegraspScorerPolicy",
-    "features_extractor=graspgait_env.agents.policies:GraspMapExtractor",
-    "features_extractor_kwargs={conv: false, forward_gait: true}",
+    "features_extractor=graspgait_env.agents.policies:PartsExtractor",
+    "env_kwargs={object: ellipse, mu: 0.7, observation_mode: dict, regrasp_lookahead: 2}",
 ]
 
 
 def _env(**kw):
     return gym.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7, **kw)
+
+
+def _parts_env():
+    """The env of :data:`_SCORER`'s models."""
+    return _env(observation_mode="dict", regrasp_lookahead=2)
+
+
+def _batch(obs):
+    return {k: torch.as_tensor(v[None]) for k, v in obs.items()}
 
 
 def _scorer_model(tmp_path, *more):
@@ -87,36 +96,34 @@ def test_regrasp_block_needs_the_forward_gait_inputs():
         GraspMapExtractor(env.observation_space, regrasp_block=True)
 
 
-def test_logits_are_the_linear_head_plus_one_shared_score_per_regrasp(tmp_path):
+def test_logits_are_the_linear_head_plus_one_shared_score_per_move(tmp_path):
     _, model = _scorer_model(tmp_path)
     policy = model.policy
     assert isinstance(policy, MaskableRegraspScorerPolicy)
     ext, mlp, head = policy.features_extractor, policy.mlp_extractor, policy.action_net
     first, count = ext.regrasp_actions
-    env = _env()
-    obs, _ = env.reset(seed=2)
-    x = torch.as_tensor(obs[None])
+    assert first == 0  # on the named parts every move is scored
+    obs, _ = _parts_env().reset(seed=2)
+    x = _batch(obs)
     with torch.no_grad():
         for p in mlp.scorer.parameters():  # a scorer whose output differs between rows
             p.normal_(0.0, 0.5)
         features = ext(x)
         logits = head(mlp.forward_actor(features))
         latent = mlp.mlp.forward_actor(features[:, :ext.block_start])
-        block = ext.regrasp_block(x)[0]
+        block = features[0, ext.block_start:].view(count, ext.block_channels)
         context = mlp.context(latent)[0]
         scores = torch.stack([mlp.scorer(torch.cat((row, context))) for row in block])[:, 0]
         linear = head.linear(latent)[0]
-    np.testing.assert_allclose(logits[0, :first].numpy(), linear[:first].numpy(), atol=1e-6)
-    np.testing.assert_allclose(logits[0, first:first + count].numpy(),
-                               (linear[first:first + count] + scores).numpy(), atol=1e-5)
+    np.testing.assert_allclose(logits[0].numpy(), (linear + scores).numpy(), atol=1e-5)
     assert float(scores.std()) > 1e-3  # the scores are not a constant the test would miss
-    # the same scorer for every regrasp: two regrasps whose block rows agree score alike
+    # the same scorer for every move: two moves whose block rows agree score alike
     with torch.no_grad():
         f2 = features.clone()
-        rows = f2[0, ext.block_start:].view(count, REGRASP_CHANNELS)
+        rows = f2[0, ext.block_start:].view(count, ext.block_channels)
         rows[7] = rows[3]
         out = head(mlp.forward_actor(f2))[0] - head.linear(latent)[0]
-    assert float(out[first + 7]) == pytest.approx(float(out[first + 3]), abs=1e-6)
+    assert float(out[7]) == pytest.approx(float(out[3]), abs=1e-6)
 
 
 def test_scorer_model_trains_saves_and_loads_with_identical_actions(tmp_path):
@@ -132,8 +139,7 @@ def test_scorer_model_trains_saves_and_loads_with_identical_actions(tmp_path):
     assert loaded.policy.scorer_arch == [32] and loaded.policy.scorer_context == 16
     for p, q in zip(model.policy.parameters(), loaded.policy.parameters(), strict=True):
         assert torch.equal(p, q)
-    env = _env()
-    assert_same_greedy_actions(model, loaded, env)
+    assert_same_greedy_actions(model, loaded, _parts_env())
 
 
 def test_init_logit_scale_scales_every_logit_scores_included(tmp_path):
@@ -144,8 +150,8 @@ def test_init_logit_scale_scales_every_logit_scores_included(tmp_path):
     path = save_agent(model, tmp_path / "src.zip", {"algo": cfg.algo, "env_id": cfg.env_id})
     cfg2, fresh = _scorer_model(tmp_path, f"init_model={path}", "init_logit_scale=0.25")
     init_from_model(fresh, cfg2)
-    obs, _ = _env().reset(seed=4)
-    x = torch.as_tensor(obs[None])
+    obs, _ = _parts_env().reset(seed=4)
+    x = _batch(obs)
     with torch.no_grad():
         def logits(m):
             pol = m.policy
@@ -163,7 +169,7 @@ def test_scorer_policy_needs_maskable_ppo_and_the_extractor(tmp_path):
     cfg = load_train_config("smoke", [f"run_root={tmp_path}", _SCORER[0]])
     with pytest.raises(GraspGaitInputError,
                        match="needs graspgait_env.agents.policies:PartsExtractor .*"
-                             "GraspMapExtractor"):
+                             "observation_mode: dict"):
         build_model(cfg, make_vec_env_for(cfg))
 
 
