@@ -103,3 +103,40 @@ def test_policy_kwargs_reach_the_scorer_and_are_saved(tmp_path):
                                                   "env_kwargs": cfg.env_kwargs})
     loaded, _ = load_agent(path)
     assert loaded.policy.scorer_arch == [8, 8]
+
+
+def test_without_the_linear_head_each_logit_is_its_moves_score(tmp_path):
+    """``linear_head: false``: no per-action weights over the latent; every legal move's
+    logit is the shared scorer's score of its row, so two moves with the same row get the
+    same logit whatever their index, and the model saves and loads so."""
+    torch.set_num_threads(1)
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                      "policy_kwargs={linear_head: false}"])
+    model = build_model(cfg, make_vec_env_for(cfg))
+    policy = model.policy
+    assert policy.action_net.linear is None
+    env = gym.make("graspgait_env:GraspGait-v0", **cfg.env_kwargs)
+    obs, _ = env.reset(seed=2)
+    x = {k: torch.as_tensor(v[None]) for k, v in obs.items()}
+    ext, mlp = policy.features_extractor, policy.mlp_extractor
+    with torch.no_grad():
+        for p in mlp.scorer.parameters():
+            p.normal_(0.0, 0.5)
+        features = ext(x)
+        logits = policy.action_net(mlp.forward_actor(features))[0]
+        latent = mlp.mlp.forward_actor(features[:, :ext.block_start])
+        context = mlp.context(latent)[0]
+        block = features[0, ext.block_start:].view(-1, ext.block_channels)
+        scores = torch.stack([mlp.scorer(torch.cat((row, context))) for row in block])[:, 0]
+    np.testing.assert_allclose(logits.numpy(), scores.numpy(), atol=1e-5)
+    assert float(scores.std()) > 1e-3
+    model.learn(128)
+    path = save_agent(model, tmp_path / "n.zip", {"algo": cfg.algo, "env_id": cfg.env_id,
+                                                  "env_kwargs": cfg.env_kwargs})
+    loaded, _ = load_agent(path)
+    assert loaded.policy.linear_head is False and loaded.policy.action_net.linear is None
+    assert_same_greedy_actions(model, loaded, env)
+    bad = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                      "policy_kwargs={linear_head: 'no'}"])
+    with pytest.raises(GraspGaitInputError, match="linear_head='no': must be true or false"):
+        build_model(bad, make_vec_env_for(bad))
