@@ -199,8 +199,8 @@ def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
             "only loads the models saved with it); train on the env's named parts: "
             "env_kwargs observation_mode: dict, features_extractor: "
             "graspgait_env.agents.policies:PartsExtractor, policy: "
-            "graspgait_env.agents.policies:MaskableRegraspScorerPolicy, as "
-            "configs/train/general.yaml does")
+            "graspgait_env.agents.policies:MaskableRegraspScorerPolicy, as the bundled "
+            "config general does (graspgait config train general)")
     return kwargs
 
 
