@@ -166,7 +166,7 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
                      f"{'' if wall is None else f'{float(wall):.0f}'} | "
                      f"{100.0 * ev['success_rate_solvable']:.1f} | "
                      f"{ev['regrasps_vs_optimal']:.3f} |")
-    hyper = {k: cfg[k] for k in ("policy", "net_arch", "features_extractor",
+    hyper = {k: cfg[k] for k in ("policy", "policy_kwargs", "net_arch", "features_extractor",
                                  "features_extractor_kwargs", "imitation", "n_envs",
                                  "n_steps", "batch_size", "n_epochs", "learning_rate",
                                  "gamma", "gae_lambda", "clip_range", "ent_coef",

@@ -610,10 +610,11 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
     features. (Models saved with the retired :class:`GraspMapExtractor`, whose regrasp
     block the policy switched on, load too.)
 
-    Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent)
-    plus a score of that move: one MLP (``scorer_arch``), the same for every move, over
-    the move's row of :class:`PartsExtractor`'s action block (the env's per-action
-    features of thesis 4.2's moves, rotations and regrasps alike: legality, the turn
+    Each action's logit is SB3's (a linear layer over the ``net_arch`` policy latent;
+    left out with ``linear_head=False``, the score alone then) plus a score of that
+    move: one MLP (``scorer_arch``), the same for every move, over the move's row of
+    :class:`PartsExtractor`'s action block (the env's per-action features of thesis
+    4.2's moves, rotations and regrasps alike: legality, the turn
     achieved and the rotation room towards and against the goal after it, the
     look-aheads' entries, each also against the best legal move) and a
     ``scorer_context``-wide ReLU projection of the policy latent (what the state asks
@@ -661,18 +662,21 @@ class MaskableRegraspScorerPolicy(MaskableActorCriticPolicy):
             raise GraspGaitInputError("policy MaskableRegraspScorerPolicy: "
                                       "share_features_extractor=False is not supported; "
                                       "leave it at True")
-        if int(scorer_context) < 1 or any(int(w) < 1 for w in scorer_arch):
+        if (isinstance(scorer_context, bool) or not isinstance(scorer_context, int)
+                or not isinstance(scorer_arch, (list, tuple))
+                or any(isinstance(w, bool) or not isinstance(w, int) for w in scorer_arch)
+                or int(scorer_context) < 1 or any(int(w) < 1 for w in scorer_arch)):
             raise GraspGaitInputError(
-                f"scorer_arch={list(scorer_arch)!r}, scorer_context={scorer_context!r}: "
+                f"policy_kwargs scorer_arch={scorer_arch!r}, scorer_context={scorer_context!r}: "
                 "widths must be positive integers, e.g. scorer_arch: [32], scorer_context: 16")
         if not isinstance(linear_head, bool):
             raise GraspGaitInputError(f"policy_kwargs linear_head={linear_head!r}: must be "
                                       "true or false")
         if not linear_head and not issubclass(extractor, PartsExtractor):
             raise GraspGaitInputError(
-                "policy_kwargs linear_head=false: needs features_extractor "
-                "graspgait_env.agents.policies:PartsExtractor (every move scored); leave "
-                "linear_head at true")
+                f"policy_kwargs linear_head=false with features_extractor "
+                f"{extractor.__name__}: needs graspgait_env.agents.policies:PartsExtractor "
+                "(every move scored); leave linear_head at true")
         # read by _build, which the base __init__ calls
         self.linear_head = linear_head
         self.scorer_arch = [int(w) for w in scorer_arch]

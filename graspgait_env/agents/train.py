@@ -204,6 +204,29 @@ def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
     return kwargs
 
 
+def _check_policy_kwargs(config: TrainConfig, policy: Any) -> None:
+    """Refuse a ``policy_kwargs`` key the policy class does not take, naming those it does
+    (SB3 would raise a bare ``TypeError`` deep in the model's construction)."""
+    import inspect
+
+    if not config.policy_kwargs:
+        return
+    cls = (_algo_class(config.algo).policy_aliases.get(policy) if isinstance(policy, str)
+           else policy)
+    names: set[str] = set()
+    for klass in inspect.getmro(cls) if isinstance(cls, type) else ():
+        if "__init__" in vars(klass):
+            names |= {n for n, p in inspect.signature(klass.__init__).parameters.items()
+                      if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    names -= {"self", "observation_space", "action_space", "lr_schedule", "net_arch",
+              "activation_fn", "features_extractor_class", "features_extractor_kwargs"}
+    unknown = sorted(set(config.policy_kwargs) - names)
+    if unknown:
+        raise GraspGaitInputError(
+            f"policy_kwargs {unknown}: not keywords of policy {config.policy!r}; it takes "
+            f"{sorted(names)}")
+
+
 def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
     """A fresh PPO / MaskablePPO model for ``config`` on the vector env ``env``."""
     import torch
@@ -226,6 +249,7 @@ def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = Non
 
     policy: Any = (config.policy if config.policy == "MlpPolicy"
                    else import_object(config.policy, "policy"))
+    _check_policy_kwargs(config, policy)
     return _algo_class(config.algo)(
         policy, env, learning_rate=lr, n_steps=config.n_steps,
         batch_size=config.batch_size, n_epochs=config.n_epochs, gamma=config.gamma,
@@ -378,7 +402,8 @@ def init_from_model(model: Any, config: TrainConfig) -> dict[str, Any]:
         first = str(exc).splitlines()[0]
         raise GraspGaitInputError(
             f"init_model={str(path)!r}: its network does not fit this config's ({first}); "
-            f"set net_arch={card.get('config', {}).get('net_arch')} and its features "
+            f"set net_arch={card.get('config', {}).get('net_arch')}, policy_kwargs="
+            f"{card.get('config', {}).get('policy_kwargs', {})} and its features "
             "extractor") from None
     if config.init_logit_scale != 1.0:  # a flatter policy, the same greedy actions
         import torch

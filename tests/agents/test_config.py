@@ -98,9 +98,8 @@ def test_torch_threads_follow_the_machine():
 def test_each_shipped_model_card_holds_its_bundled_config(name):
     """`graspgait train NAME` trains the shipped model's config: the bundled YAML and the
     config in `agents/models/NAME.json` make the same TrainConfig (a field added after
-    a card was written takes its default), but for the extractor's keywords, where the
-    YAML gives switches and the trainer the env's geometry: those must come to the
-    card's."""
+    a card was written takes its default), the extractor's keywords as the trainer
+    builds them (``extractor_kwargs``: the config's own) included."""
     import dataclasses
     import json
 

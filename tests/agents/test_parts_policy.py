@@ -140,3 +140,18 @@ def test_without_the_linear_head_each_logit_is_its_moves_score(tmp_path):
                                       "policy_kwargs={linear_head: 'no'}"])
     with pytest.raises(GraspGaitInputError, match="linear_head='no': must be true or false"):
         build_model(bad, make_vec_env_for(bad))
+
+
+def test_bad_policy_kwargs_name_the_field_and_the_fix(tmp_path):
+    for kw, match in (("{linear_heed: false}", r"policy_kwargs \['linear_heed'\]: not keywords "
+                       r"of policy .*MaskableRegraspScorerPolicy.*'linear_head'"),
+                      ("{scorer_arch: 32}", r"policy_kwargs scorer_arch=32, scorer_context=16: "
+                       r"widths must be positive integers")):
+        cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                          f"policy_kwargs={kw}"])
+        with pytest.raises(GraspGaitInputError, match=match):
+            build_model(cfg, make_vec_env_for(cfg))
+    plain = load_train_config("smoke", [f"run_root={tmp_path}",
+                                        "policy_kwargs={linear_head: false}"])
+    with pytest.raises(GraspGaitInputError, match=r"not keywords of policy 'MlpPolicy'"):
+        build_model(plain, make_vec_env_for(plain))
