@@ -216,7 +216,8 @@ class TrainConfig:
     max_grad_norm: float = 0.5
     """Gradient clipping norm."""
     total_timesteps: int = 200_000
-    """Environment steps to train for (all envs together)."""
+    """PPO's environment steps (all envs together); 0 with ``imitation``: the imitation
+    alone (no PPO update; the final evaluation and the card as after PPO)."""
     eval_freq: int = 25_000
     """Evaluate every this many environment steps (0: only at the end)."""
     eval_episodes: int = 40
@@ -328,7 +329,12 @@ class TrainConfig:
             put(name, check_number(name, getattr(self, name), example, minimum=0.0))
         put("max_grad_norm", check_number("max_grad_norm", self.max_grad_norm, 0.5,
                                           minimum=0.0, strict=True))
-        put("total_timesteps", check_count("total_timesteps", self.total_timesteps, 1, 200_000))
+        if self.total_timesteps == 0 and self.imitation is None:
+            raise GraspGaitInputError(
+                "total_timesteps=0: trains nothing without an imitation block; give >= 1, "
+                "e.g. 200000, or imitation: {...} (the imitation alone)")
+        put("total_timesteps", check_count("total_timesteps", self.total_timesteps,
+                                           0 if self.imitation is not None else 1, 200_000))
         put("eval_freq", check_count("eval_freq", self.eval_freq, 0, 25_000))
         put("eval_episodes", check_count("eval_episodes", self.eval_episodes, 1, 40))
         if self.best_success_floor is not None:

@@ -135,3 +135,24 @@ def test_the_greedy_teacher_keeps_the_greedy_move_unless_it_wastes_a_regrasp() -
         [[0, 0, 1, 0, 0], [1, 0, 0, 0, 0], [0, 1, 0, 1, 0], [0, 0, 0, 0, 0]], dtype=bool))
     with pytest.raises(GraspGaitInputError, match=r"imitation\.teacher='best'"):
         Imitation(teacher="best")
+
+
+def test_total_timesteps_0_trains_the_imitation_alone(tmp_path):
+    """``total_timesteps: 0`` with an imitation block: DAgger, then no PPO update; the
+    model is saved with its card and final evaluation at 0 steps. Without the block 0 is
+    refused with the fix."""
+    import torch
+
+    torch.set_num_threads(1)
+    from graspgait_env.agents.card import read_card
+    from graspgait_env.agents.train import train
+
+    res = train(load_train_config("general", [*TINY, "total_timesteps=0",
+                                              f"run_root={tmp_path}"]), progress=False)
+    card = read_card(res.model_path)
+    assert res.steps == 0 and card["steps"] == 0
+    assert card["imitation"]["labels"] >= 192
+    assert card["eval"] is not None and card["eval"]["steps"] == 0
+    with pytest.raises(GraspGaitInputError, match=r"total_timesteps=0: trains nothing without "
+                       r"an imitation block"):
+        load_train_config("smoke", ["total_timesteps=0"])
