@@ -32,6 +32,7 @@ from graspgait_env.resources import bundled_file, bundled_names
 
 __all__ = [
     "ALGOS",
+    "OWN_POLICY_KWARGS",
     "VEC_ENVS",
     "TrainConfig",
     "apply_overrides",
@@ -51,9 +52,11 @@ VEC_ENVS = ("dummy", "subproc", "batched")
 (:mod:`graspgait_env.agents.vec_env`; ``GraspGait-v0`` and ``GraspGaitRandom-v0`` without
 wrappers only, same transitions)."""
 ACTIVATIONS = ("tanh", "relu")
-_OWN_POLICY_KWARGS = {"net_arch": "net_arch", "activation_fn": "activation",
-                      "features_extractor_class": "features_extractor",
-                      "features_extractor_kwargs": "features_extractor_kwargs"}
+OWN_POLICY_KWARGS = {"net_arch": "net_arch", "activation_fn": "activation",
+                     "features_extractor_class": "features_extractor",
+                     "features_extractor_kwargs": "features_extractor_kwargs"}
+"""SB3 policy keywords that a training config sets by its own fields (keyword -> field),
+refused in ``policy_kwargs``."""
 
 
 class _Loader(yaml.SafeLoader):
@@ -297,11 +300,11 @@ class TrainConfig:
             raise GraspGaitInputError(
                 f"policy_kwargs={self.policy_kwargs!r}: must be a mapping, e.g. "
                 "{scorer_arch: [64]}")
-        own = sorted(set(self.policy_kwargs) & set(_OWN_POLICY_KWARGS))
+        own = sorted(set(self.policy_kwargs) & set(OWN_POLICY_KWARGS))
         if own:
             raise GraspGaitInputError(
                 f"policy_kwargs {own}: set by their own fields; use "
-                + ", ".join(_OWN_POLICY_KWARGS[k] for k in own) + " instead")
+                + ", ".join(OWN_POLICY_KWARGS[k] for k in own) + " instead")
         put("policy_kwargs", dict(self.policy_kwargs))
         put("n_envs", check_count("n_envs", self.n_envs, 1, 8))
         put("vec_env", _check_str("vec_env", self.vec_env, VEC_ENVS))
@@ -333,8 +336,7 @@ class TrainConfig:
             raise GraspGaitInputError(
                 "total_timesteps=0: trains nothing without an imitation block; give >= 1, "
                 "e.g. 200000, or imitation: {...} (the imitation alone)")
-        put("total_timesteps", check_count("total_timesteps", self.total_timesteps,
-                                           0 if self.imitation is not None else 1, 200_000))
+        put("total_timesteps", check_count("total_timesteps", self.total_timesteps, 0, 200_000))
         put("eval_freq", check_count("eval_freq", self.eval_freq, 0, 25_000))
         put("eval_episodes", check_count("eval_episodes", self.eval_episodes, 1, 40))
         if self.best_success_floor is not None:

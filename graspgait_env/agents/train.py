@@ -42,7 +42,7 @@ import yaml
 from tqdm.auto import tqdm
 
 from graspgait_env.agents.card import load_agent, read_card, resolve_model, save_agent
-from graspgait_env.agents.config import TrainConfig
+from graspgait_env.agents.config import OWN_POLICY_KWARGS, TrainConfig
 from graspgait_env.agents.envs import contact_model_of, import_object, make_env
 from graspgait_env.agents.evaluate import (
     EVAL_BATCH,
@@ -218,8 +218,7 @@ def _check_policy_kwargs(config: TrainConfig, policy: Any) -> None:
         if "__init__" in vars(klass):
             names |= {n for n, p in inspect.signature(klass.__init__).parameters.items()
                       if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
-    names -= {"self", "observation_space", "action_space", "lr_schedule", "net_arch",
-              "activation_fn", "features_extractor_class", "features_extractor_kwargs"}
+    names -= {"self", "observation_space", "action_space", "lr_schedule", *OWN_POLICY_KWARGS}
     unknown = sorted(set(config.policy_kwargs) - names)
     if unknown:
         raise GraspGaitInputError(
