@@ -58,7 +58,7 @@ from graspgait_env.gait import GaitModel
 __all__ = ["SHIPPED_AGENTS", "Agent", "agents_markdown", "find_agents", "plot_bench",
            "run_agent_bench", "shipped_models_dir"]
 
-SHIPPED_AGENTS = ("circle", "ellipse", "pentagon", "hexagon", "random")
+SHIPPED_AGENTS = ("general", "circle", "ellipse", "pentagon", "hexagon", "random")
 """The agents the project ships (``models/NAME.zip`` of :mod:`graspgait_env.agents`, with
 their cards); a test fails when one is missing from the install."""
 
