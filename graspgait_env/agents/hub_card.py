@@ -18,7 +18,10 @@ Metrics (from each card's ``eval``, the training run's last periodic evaluation)
 - ``success``: the success rate over the evaluation starts from which a gait exists, %;
 - ``regrasps / optimum``: the agent's regrasps over the exact optimum's on its
   successful episodes (1 = optimal), and ``regrasps / rule`` against the rule-based gait;
-- ``training wall time`` (s) and ``steps``.
+- ``training wall time`` (s) and ``PPO steps`` (the model's ``num_timesteps``: 0 for a
+  recipe that learns by imitation alone), with ``imitation labels`` and ``imitation env
+  steps`` (the states DAgger trained on and the env steps it took to collect them) for a
+  recipe with an ``imitation:`` block.
 
 ``std`` is the population standard deviation over runs (NumPy's default, ``ddof = 0``),
 as CleanRL reports; with one run it is 0 and the card says "1 run".
@@ -156,8 +159,13 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     if walls:
         lines.append(f"| training wall time (s) | {_stat(walls, 1.0, '.0f')} | {len(walls)} |")
     if steps:
-        lines.append(f"| environment steps | {_stat(steps, 1.0, '.0f')} | {len(steps)} |")
-    lines += ["", "| run | seed | steps | wall time (s) | success (%) | regrasps / optimum |",
+        lines.append(f"| PPO steps | {_stat(steps, 1.0, '.0f')} | {len(steps)} |")
+    for key, label in (("labels", "imitation labels"), ("env_steps", "imitation env steps")):
+        vals = [int(c["imitation"][key]) for c in cards
+                if isinstance(c.get("imitation"), Mapping) and key in c["imitation"]]
+        if vals:
+            lines.append(f"| {label} | {_stat(vals, 1.0, '.0f')} | {len(vals)} |")
+    lines += ["", "| run | seed | PPO steps | wall time (s) | success (%) | regrasps / optimum |",
               "|---|---:|---:|---:|---:|---:|"]
     for card, name in zip(cards, names, strict=True):
         ev = card["eval"]

@@ -47,6 +47,19 @@ def test_metrics_are_mean_and_population_std_over_runs():
     assert "| training wall time (s) | 500 +/- 100 | 2 |" in text
     assert "graspgait train general --seeds 0,1 --ray" in text
     assert "| `b/model.zip` | 1 | 2048 | 600 | 100.0 | 1.000 |" in text
+    assert "| PPO steps | 2048 +/- 0 | 2 |" in text and "imitation" not in text
+
+
+def test_imitation_labels_and_env_steps_are_reported_over_runs():
+    # by hand: labels 40000, 40010 -> 40005 +/- 5; env steps 140000, 140100 -> 140050 +/- 50
+    runs = [_run(0, 1.0, 1.0, 400.0), _run(1, 1.0, 1.0, 400.0)]
+    for card, labels, env_steps in zip(runs, (40000, 40010), (140000, 140100), strict=True):
+        card["steps"] = 0
+        card["imitation"] = {"iterations": 10, "labels": labels, "env_steps": env_steps}
+    text = hub_card(runs, names=["a/model.zip", "b/model.zip"])
+    assert "| PPO steps | 0 +/- 0 | 2 |" in text
+    assert "| imitation labels | 40005 +/- 5 | 2 |" in text
+    assert "| imitation env steps | 140050 +/- 50 | 2 |" in text
     assert metric_stats([1.0, 2.0, 3.0, 4.0]) == pytest.approx((2.5, 1.118033988749895))
 
 
