@@ -985,7 +985,7 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
 def _cmd_card(args: argparse.Namespace) -> int:
     from graspgait_env.agents.hub_card import write_hub_card
 
-    text = write_hub_card(args.models, args.out, args.title)
+    text = write_hub_card(args.models, args.out, args.title, args.benchmark or ())
     if args.out is None:
         sys.stdout.write(text)
     else:
@@ -1004,11 +1004,18 @@ def _add_card(sub: argparse._SubParsersAction) -> None:
                        "`graspgait train CONFIG --seeds 0-4`). Runs of different recipes "
                        "(algo, env id or env keywords) are refused.",
                        epilog=_epilog(["card runs/*general*/model.zip --out README.md",
+                                       "card general runs/general-s1/model.zip "
+                                       "--benchmark bench/agent --benchmark bench/seeds",
                                        "card ellipse"], duration="a second"))
     p.add_argument("models", metavar="MODEL", nargs="+",
                    help="saved models (zips with their cards) or shipped agents' names")
     p.add_argument("--out", metavar="FILE", help="write the card here (default: print it)")
     p.add_argument("--title", help="the card's heading (default: recipe and env id)")
+    p.add_argument("--benchmark", metavar="DIR", action="append",
+                   help="a finished `graspgait benchmark` row's folder (its --out) to add "
+                   "to the card; repeatable: with the shipped run's row (agent:NAME) and the "
+                   "retrained recipe's (RUNS/s{seed}/model.zip or config:NAME) the card says "
+                   "whether the recipe retrained is worse")
     p.set_defaults(func=_cmd_card)
 
 

@@ -25,6 +25,14 @@ Metrics (from each card's ``eval``, the training run's last periodic evaluation)
 
 ``std`` is the population standard deviation over runs (NumPy's default, ``ddof = 0``),
 as CleanRL reports; with one run it is 0 and the card says "1 run".
+
+``--benchmark DIR`` (:func:`benchmark_section`) adds the rows of ``graspgait benchmark``
+that the recipe made, read from each row folder's ``result.json``: the suite IQM and mean
+with their 95% stratified bootstrap intervals and the IQM per track. Where one row is the
+shipped run (``agent:NAME``) and another the recipe retrained over seeds (a model
+template ``RUNS/s{seed}/model.zip`` or ``config:NAME``), on the same tasks and seeds, the
+card says whether the retrained recipe's IQM is below the shipped run's: then it is
+**worse**, however little (the benchmark's rule, docs/benchmark.md).
 """
 
 from __future__ import annotations
@@ -41,7 +49,7 @@ import yaml
 
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["METRICS", "hub_card", "metric_stats", "write_hub_card"]
+__all__ = ["METRICS", "benchmark_section", "hub_card", "metric_stats", "write_hub_card"]
 
 #: (key in a card's ``eval``, name in the card, scale, format) of each metric.
 METRICS: tuple[tuple[str, str, float, str], ...] = (
@@ -76,7 +84,9 @@ def _stat(values: Sequence[float], scale: float, fmt: str) -> str:
 
 
 def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None = None,
-             title: str | None = None) -> str:
+             title: str | None = None,
+             benchmarks: Sequence[Mapping[str, Any]] = (),
+             benchmark_names: Sequence[str] | None = None) -> str:
     """The Markdown model card (Hugging Face front matter first) of one recipe's runs.
 
     Parameters
@@ -89,6 +99,9 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
         model path, usually.
     title
         The card's heading (default: the recipe's config name and env id).
+    benchmarks, benchmark_names
+        ``graspgait benchmark`` rows' ``result.json`` to add as a ``## Benchmark``
+        section (:func:`benchmark_section`), and how errors name them.
 
     Returns
     -------
@@ -185,7 +198,10 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     lines.append(f"graspgait train {shlex.quote(recipe)} --seeds {seeds_arg}"
                  + (" --ray" if n > 1 else ""))
     lines.append("graspgait card RUN_ROOT/*/model.zip --out README.md")
-    lines += ["```", "", "## Use", "", "```bash",
+    lines += ["```"]
+    if benchmarks:
+        lines += benchmark_section(benchmarks, benchmark_names)
+    lines += ["", "## Use", "", "```bash",
               f"graspgait evaluate {shlex.quote(names[0])} --episodes 100", "```", "",
               "```python", "from graspgait_env.agents.card import load_agent",
               "", f"model, card = load_agent({names[0]!r})", "```", "",
@@ -194,17 +210,105 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     return "\n".join(lines) + "\n"
 
 
+_SHIPPED_KINDS = ("agent",)  # a benchmark row of the one shipped run
+_RETRAINED_KINDS = ("agent-template", "config")  # rows of the recipe trained once per seed
+
+
+def _ci(block: Mapping[str, Any], key: str) -> str:
+    lo, hi = block[f"{key}_ci"]
+    return f"{100.0 * block[key]:.1f} [{100.0 * lo:.1f}, {100.0 * hi:.1f}]"
+
+
+def benchmark_section(results: Sequence[Mapping[str, Any]],
+                      names: Sequence[str] | None = None) -> list[str]:
+    """The card's ``## Benchmark`` lines from ``graspgait benchmark`` rows (module
+    docstring).
+
+    Parameters
+    ----------
+    results
+        Each row's ``result.json`` (keys ``policy``, ``spec``, ``suite_version``,
+        ``tasks``, ``seeds``, ``command``, ``date``, ``run_wall_s``, ``aggregate`` with
+        ``overall`` and ``tracks``).
+    names
+        How each row is named in errors (its folder, usually).
+
+    Raises
+    ------
+    GraspGaitInputError
+        A row without a suite aggregate, or rows of different suite versions, tasks or
+        seeds.
+    """
+    names = list(names) if names is not None else [f"row {i + 1}" for i in range(len(results))]
+    for res, name in zip(results, names, strict=True):
+        if not isinstance(res.get("aggregate"), Mapping) or "overall" not in res["aggregate"]:
+            raise GraspGaitInputError(
+                f"--benchmark {name}: no suite aggregate in its result.json; give the folder "
+                "of a finished `graspgait benchmark` row (its --out)")
+    first = results[0]
+    for res, name in zip(results[1:], names[1:], strict=True):
+        for key in ("suite_version", "tasks", "seeds"):
+            if res.get(key) != first.get(key):
+                raise GraspGaitInputError(
+                    f"--benchmark {name}: its {key} {res.get(key)!r} differs from "
+                    f"{names[0]}'s {first.get(key)!r}; rows compared in a card share the "
+                    "suite, the tasks and the seeds")
+    tracks = list(dict.fromkeys(t for r in results for t in r["aggregate"].get("tracks", {})))
+    seeds = ",".join(str(s) for s in first.get("seeds") or [])
+    lines = ["", f"## Benchmark (suite v{first.get('suite_version')}, seeds {seeds})", "",
+             "Score in percent (success x efficiency) over the benchmark's test starts; "
+             "IQM and mean over the (run, task) scores with 95% stratified bootstrap "
+             "intervals (`graspgait benchmark`, docs/benchmark.md).", "",
+             "| row | tasks | IQM [95% CI] | mean [95% CI] | "
+             + " | ".join(f"{t} IQM" for t in tracks) + " | wall time (s) | date | command |",
+             "|---|---:|---|---|" + "---|" * len(tracks) + "---:|---|---|"]
+    for res in results:
+        agg = res["aggregate"]
+        per = [_ci(agg["tracks"][t], "iqm") if t in agg.get("tracks", {}) else "-"
+               for t in tracks]
+        wall = res.get("run_wall_s")
+        what = {"agent": " (the shipped run)", "agent-template": " (retrained per seed)",
+                "config": " (retrained per seed)"}.get(str((res.get("spec") or {}).get("kind")),
+                                                      "")
+        lines.append(f"| `{res.get('policy')}`{what} | {agg['overall'].get('tasks')} | "
+                     f"{_ci(agg['overall'], 'iqm')} | {_ci(agg['overall'], 'mean')} | "
+                     + " | ".join(per) + f" | {'' if wall is None else f'{float(wall):.0f}'}"
+                     f" | {res.get('date', '')} | `{res.get('command', '')}` |")
+    kind = [str((r.get("spec") or {}).get("kind", "")) for r in results]
+    shipped = [r for r, k in zip(results, kind, strict=True) if k in _SHIPPED_KINDS]
+    retrained = [r for r, k in zip(results, kind, strict=True) if k in _RETRAINED_KINDS]
+    if len(shipped) == 1 and len(retrained) == 1:
+        a = shipped[0]["aggregate"]["overall"]["iqm"]
+        b = retrained[0]["aggregate"]["overall"]["iqm"]
+        verdict = ("**worse** than its shipped run" if b < a else
+                   "as good as its shipped run or better")
+        lines += ["", f"Retrained over the seeds, the recipe is {verdict}: IQM "
+                  f"{100.0 * b:.1f} against {100.0 * a:.1f} "
+                  f"({100.0 * (b - a):+.1f} points)."]
+    return lines
+
+
 def write_hub_card(models: Sequence[str | os.PathLike[str]],
                    out: str | os.PathLike[str] | None = None,
-                   title: str | None = None) -> str:
-    """:func:`hub_card` of the saved models ``models`` (zips with their JSON cards);
-    written atomically to ``out`` when given. Returns the card."""
+                   title: str | None = None,
+                   benchmarks: Sequence[str | os.PathLike[str]] = ()) -> str:
+    """:func:`hub_card` of the saved models ``models`` (zips with their JSON cards), with
+    the ``graspgait benchmark`` row folders ``benchmarks`` (each with its
+    ``result.json``); written atomically to ``out`` when given. Returns the card."""
     from graspgait_env.agents.card import read_card, resolve_model
     from graspgait_env.atomic import write_text_atomic
 
     paths = [resolve_model(m) for m in models]
+    rows = []
+    for d in benchmarks:
+        path = Path(d) / "result.json"
+        if not path.is_file():
+            raise GraspGaitInputError(
+                f"--benchmark {d}: no result.json there; give the folder of a finished "
+                "`graspgait benchmark` row (its --out)")
+        rows.append(json.loads(path.read_text(encoding="utf-8")))
     text = hub_card([read_card(p) for p in paths], names=[str(m) for m in models],
-                    title=title)
+                    title=title, benchmarks=rows, benchmark_names=[str(d) for d in benchmarks])
     if out is not None:
         write_text_atomic(Path(out), text)
     return text

@@ -85,3 +85,36 @@ def test_card_command_writes_a_shipped_agents_card(tmp_path, capsys):
     assert '"object": "circle"' in text and "graspgait evaluate circle" in text
     assert main(["card", "circle", "nope_model.zip"]) == 2
     assert "nope_model.zip" in capsys.readouterr().err
+
+
+def _row(kind: str, iqm: float, seeds=(0, 1)) -> dict:
+    block = {"iqm": iqm, "iqm_ci": [iqm - 0.01, iqm], "mean": iqm, "mean_ci": [iqm, iqm],
+             "tasks": 2}
+    return {"policy": f"{kind}-general", "spec": {"kind": kind}, "suite_version": 1,
+            "tasks": ["map-hand-circle", "random-l1"], "seeds": list(seeds),
+            "command": f"graspgait benchmark {kind}", "date": "2026-12-06",
+            "run_wall_s": 120.0,
+            "aggregate": {"overall": block, "tracks": {"map-hand": {**block, "tasks": 1}}}}
+
+
+def test_benchmark_rows_say_when_the_retrained_recipe_is_worse():
+    text = hub_card([_run(0, 1.0, 1.0, 400.0)], names=["general"],
+                    benchmarks=[_row("agent", 0.998), _row("agent-template", 0.997)])
+    assert "## Benchmark (suite v1, seeds 0,1)" in text
+    assert ("| `agent-general` (the shipped run) | 2 | 99.8 [98.8, 99.8] | 99.8 [99.8, 99.8] | "
+            "99.8 [98.8, 99.8] |") in text
+    assert ("the recipe is **worse** than its shipped run: IQM 99.7 against 99.8 "
+            "(-0.1 points)") in text
+    even = hub_card([_run(0, 1.0, 1.0, 400.0)],
+                    benchmarks=[_row("agent", 0.99), _row("config", 0.99)])
+    assert "as good as its shipped run or better: IQM 99.0 against 99.0" in even
+    assert "**worse**" not in even
+    with pytest.raises(GraspGaitInputError, match="--benchmark b: its seeds"):
+        hub_card([_run(0, 1.0, 1.0, 400.0)],
+                 benchmarks=[_row("agent", 0.9), _row("config", 0.9, (0,))],
+                 benchmark_names=["a", "b"])
+
+
+def test_card_command_refuses_a_benchmark_folder_without_a_result(tmp_path, capsys):
+    assert main(["card", "circle", "--benchmark", str(tmp_path)]) == 2
+    assert "no result.json there" in capsys.readouterr().err
