@@ -1,5 +1,7 @@
 """The reference pages' Python examples run (each block in a fresh interpreter), as the
-README's do; the tutorials' run in tests/docs/test_tutorials.py."""
+README's do; the tutorials' run in tests/docs/test_tutorials.py. A block whose first line
+is a comment starting ``# slow`` (a measurement that takes minutes) runs in the slow suite
+only (``make test-all``)."""
 
 from __future__ import annotations
 
@@ -27,8 +29,13 @@ def _snippets() -> list[tuple[str, int, str]]:
     return out
 
 
-@pytest.mark.parametrize(("page", "i", "code"), _snippets(),
-                         ids=[f"{p}-{i}" for p, i, _ in _snippets()])
+def _params() -> list:
+    return [pytest.param(p, i, code, id=f"{p}-{i}",
+                         marks=[pytest.mark.slow] if code.startswith("# slow") else [])
+            for p, i, code in _snippets()]
+
+
+@pytest.mark.parametrize(("page", "i", "code"), _params())
 def test_page_snippet_runs(page: str, i: int, code: str, tmp_path: Path) -> None:
     env = {**os.environ, "MPLBACKEND": "Agg", "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
     run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
