@@ -856,7 +856,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     if args.list:
         return _print_shipped()
     if args.model is None:
-        raise GraspGaitInputError("MODEL missing: give a shipped agent's name (e.g. ellipse; "
+        raise GraspGaitInputError("MODEL missing: give a shipped agent's name (e.g. general; "
                                   f"`{PROG} evaluate --list` names them) or a model zip path")
     _require("train", "graspgait evaluate")
     _require_ray(args, "graspgait evaluate")
@@ -901,7 +901,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                        "settings the model was trained with (from its card). Needs the [train] "
                        "extra.",
                        epilog=_epilog(["evaluate --list",
-                                       "evaluate ellipse --episodes 20",
+                                       "evaluate general --object ellipse --episodes 20",
                                        "evaluate random --object my_shape.yaml --mu 0.5",
                                        "evaluate runs/RUN/model.zip --json eval.json",
                                        "evaluate hexagon --env GraspGaitMujoco-v1 --episodes 5"],
@@ -968,11 +968,11 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
                        "agent does not reach the turn. Needs the [train] extra.",
                        epilog=_epilog(["story", "story hexagon --out story",
                                        "story random --object my_shape.yaml --mu 0.6",
-                                       "story ellipse --start 50,270"],
+                                       "story general --object ellipse --start 50,270"],
                                       duration="5-20 s"))
-    p.add_argument("model", metavar="MODEL", nargs="?", default="ellipse",
+    p.add_argument("model", metavar="MODEL", nargs="?", default="general",
                    help="a shipped agent's name (see --list) or a model zip with its card "
-                   "(default ellipse)")
+                   "(default general, on its env's default object, the ellipse)")
     p.add_argument("--list", action="store_true", help="name the shipped agents and exit")
     p.add_argument("--object", metavar="NAME|PATH", help="object (default: the trained one)")
     p.add_argument("--mu", type=float, help="friction coefficient (default: the trained one)")
@@ -1006,7 +1006,7 @@ def _add_card(sub: argparse._SubParsersAction) -> None:
                        epilog=_epilog(["card runs/*general*/model.zip --out README.md",
                                        "card general runs/general-s1/model.zip "
                                        "--benchmark bench/agent --benchmark bench/seeds",
-                                       "card ellipse"], duration="a second"))
+                                       "card hexagon"], duration="a second"))
     p.add_argument("models", metavar="MODEL", nargs="+",
                    help="saved models (zips with their cards) or shipped agents' names")
     p.add_argument("--out", metavar="FILE", help="write the card here (default: print it)")

@@ -41,10 +41,37 @@ from graspgait_env.atomic import atomic_write, write_text_atomic
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.extras import require_extra
 
-__all__ = ["CARD_FORMAT", "card_path", "describe_shipped", "load_agent", "read_card",
-           "resolve_model", "save_agent", "shipped_agents", "shipped_models_dir", "versions"]
+__all__ = ["CARD_FORMAT", "RETIRED_AGENTS", "card_path", "describe_shipped", "load_agent",
+           "read_card", "resolve_model", "retired_message", "save_agent", "shipped_agents",
+           "shipped_models_dir", "versions"]
 
 CARD_FORMAT = "graspgait-model-card/1"
+
+RETIRED_AGENTS: dict[str, str] = {
+    "ellipse": "retired after graspgait_env 0.2.0: over 5 seeds on the ellipse's three benchmark "
+               "tasks the shipped agent general scores as well (IQM 100.0 [100.0, 100.0] "
+               "against the ellipse recipe's 100.0 [100.0, 100.0])",
+    "pentagon": "retired after graspgait_env 0.2.0: over 5 seeds on the pentagon's three "
+                "benchmark tasks the shipped agent general scores as well (IQM 100.0 [100.0, "
+                "100.0] against the pentagon recipe's 100.0 [99.4, 100.0])",
+}
+"""Shipped agents that are no longer shipped, by name: why (one clause). A per-object
+agent stays shipped only where it is measurably better than ``general`` on its object over
+5 seeds (docs/agents.md); asking for a retired one by name raises an error that says so
+and names the replacement, ``general`` on the same object. Its training config stays
+bundled (``graspgait train ellipse`` still trains the recipe)."""
+
+
+def retired_message(name: str, field: str = "MODEL") -> str | None:
+    """The error for asking for the retired shipped agent ``name`` (``None`` when ``name``
+    is not a retired agent): why it was retired and the command that replaces it."""
+    why = RETIRED_AGENTS.get(name)
+    if why is None:
+        return None
+    return (f"{field} {name!r}: the shipped agent {name!r} was {why}; use general on that "
+            f"object instead (`graspgait evaluate general --object {name}`, `graspgait "
+            f"story general --object {name}`), or train the recipe yourself with "
+            f"`graspgait train {name}` and give its model.zip")
 
 
 def shipped_models_dir() -> Path:
@@ -55,7 +82,7 @@ def shipped_models_dir() -> Path:
 
 
 def shipped_agents() -> list[str]:
-    """Names of the shipped agents (``["circle", "ellipse", ...]``), sorted: the stems of
+    """Names of the shipped agents (``["circle", "general", ...]``), sorted: the stems of
     the model zips in :func:`shipped_models_dir` that have a card beside them."""
     folder = shipped_models_dir()
     return sorted(p.stem for p in folder.glob("*.zip") if card_path(p).is_file())
@@ -89,7 +116,9 @@ def resolve_model(spec: str | os.PathLike[str]) -> Path:
     Raises
     ------
     GraspGaitInputError
-        Neither a file nor a shipped agent; the message lists the shipped agents.
+        Neither a file nor a shipped agent; the message lists the shipped agents. For a
+        retired agent's name (:data:`RETIRED_AGENTS`), the message says why it was retired
+        and names its replacement.
     """
     path = Path(spec)
     if path.is_file():
@@ -97,9 +126,13 @@ def resolve_model(spec: str | os.PathLike[str]) -> Path:
     if path.suffix != ".zip" and path.with_suffix(".zip").is_file():
         return path.with_suffix(".zip")
     if len(path.parts) == 1:
-        shipped = shipped_models_dir() / f"{path.stem if path.suffix == '.zip' else path.name}.zip"
+        name = path.stem if path.suffix == ".zip" else path.name
+        shipped = shipped_models_dir() / f"{name}.zip"
         if shipped.is_file():
             return shipped
+        retired = retired_message(name)
+        if retired is not None:
+            raise GraspGaitInputError(retired)
     names = shipped_agents()
     near = difflib.get_close_matches(str(spec), names, n=1)
     hint = f"did you mean {near[0]!r}? " if near else ""
@@ -256,7 +289,7 @@ def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple
 
     Examples
     --------
-    >>> model, card = load_agent("ellipse")  # doctest: +SKIP
+    >>> model, card = load_agent("hexagon")  # doctest: +SKIP
     >>> card["env_id"]  # doctest: +SKIP
     'GraspGait-v0'
     """

@@ -49,7 +49,7 @@ def learned_gait(model_path: str | os.PathLike[str],
     Parameters
     ----------
     model_path
-        A model zip with its card (``agents/models/ellipse.zip``).
+        A model zip with its card (``agents/models/general.zip``).
     start
         ``{finger number: contact_deg}`` or a :class:`GaitState` at θ = 0 (the env's
         ``reset(options={"start": ...})``); None: the planners' default start

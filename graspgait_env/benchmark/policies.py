@@ -145,13 +145,13 @@ def parse_policy(text: str) -> PolicySpec:
     if path.suffix in (".yaml", ".yml"):
         _load_config(text)
         return PolicySpec("config", str(path), f"config-{_label(path.stem)}")
-    if path.suffix == ".zip" or path.is_file() or text in _shipped():
+    if path.suffix == ".zip" or path.is_file() or text in _shipped() or text in _retired():
         model = _resolve_model(text)
         stem = path.stem if path.stem != "model" else f"{path.parent.name}-model"
         return PolicySpec("agent", str(model), f"agent-{_label(stem)}")
     raise GraspGaitInputError(
         f"POLICY {text!r}: not a policy; give random, a planner ({', '.join(PLANNERS)}), "
-        "greedy-reach[:D], a shipped agent (agent:NAME, e.g. agent:ellipse) or a model .zip, a "
+        "greedy-reach[:D], a shipped agent (agent:NAME, e.g. agent:general) or a model .zip, a "
         "training config (config:NAME, e.g. config:ellipse, or a .yaml path), RL Zoo "
         "(rlzoo:ppo), or bc[:optimal|rule]")
 
@@ -232,6 +232,12 @@ def _shipped() -> list[str]:
         return shipped_agents()
     except ImportError:  # pragma: no cover - the agents package always installs
         return []
+
+
+def _retired() -> dict[str, str]:
+    from graspgait_env.agents.card import RETIRED_AGENTS  # its error names the replacement
+
+    return RETIRED_AGENTS
 
 
 def _resolve_model(text: str) -> Path:

@@ -50,7 +50,7 @@ def test_find_agents(smoke_run):
     assert agent.name == "model" and not notes
     assert agent.runs_on("ellipse") and not agent.runs_on("pentagon")
     with pytest.raises(GraspGaitInputError, match=r"--agents: MODEL 'nope': no such file "
-                       r"and no shipped agent.*circle, ellipse"):
+                       r"and no shipped agent.*circle, general"):
         find_agents("nope")
 
 
@@ -87,9 +87,9 @@ def test_an_agent_with_its_own_contact_model_is_compared_under_it():
 
 def test_hand_agent_runs_from_starts_legal_under_its_contact_model():
     """At mu 0.8 some point-contact bench starts are not force-closure for the hand; the
-    shipped ellipse agent (hand contacts) runs from its own model's starts, with the
-    optimum under the same model, which it never beats."""
-    agents, _ = find_agents("ellipse")
+    shipped general agent (hand contacts) runs on the ellipse from its own model's starts,
+    with the optimum under the same model, which it never beats."""
+    agents, _ = find_agents("general")
     cases = run_agent_bench(agents, ["ellipse"], [0.8], starts=2, progress=False)
     assert len(cases) == 2
     for c in cases:

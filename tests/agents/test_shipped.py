@@ -14,13 +14,14 @@ import pytest
 
 from graspgait_env.agents.bench import SHIPPED_AGENTS
 from graspgait_env.agents.card import (
+    RETIRED_AGENTS,
     describe_shipped,
     load_agent,
     resolve_model,
     shipped_agents,
     shipped_models_dir,
 )
-from graspgait_env.agents.config import TrainConfig
+from graspgait_env.agents.config import TrainConfig, load_train_config
 from graspgait_env.agents.envs import make_env
 from graspgait_env.agents.evaluate import evaluate
 from graspgait_env.agents.legacy import legacy_module_names, upgrade_card, upgrade_import_path
@@ -49,18 +50,37 @@ def test_every_shipped_agent_is_installed_with_both_cards():
 
 
 def test_shipped_names_resolve_and_unknown_names_list_what_exists(tmp_path, monkeypatch):
-    assert resolve_model("ellipse") == shipped_models_dir() / "ellipse.zip"
-    assert resolve_model("ellipse.zip") == shipped_models_dir() / "ellipse.zip"
+    assert resolve_model("hexagon") == shipped_models_dir() / "hexagon.zip"
+    assert resolve_model("hexagon.zip") == shipped_models_dir() / "hexagon.zip"
     # a file of that name in the working folder is the user's, and wins
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "ellipse.zip").write_bytes(b"")
-    assert resolve_model("ellipse") == Path("ellipse.zip")
+    (tmp_path / "hexagon.zip").write_bytes(b"")
+    assert resolve_model("hexagon") == Path("hexagon.zip")
     with pytest.raises(GraspGaitInputError) as err:
-        resolve_model("elipse")
+        resolve_model("hexagn")
     msg = str(err.value)
-    assert "did you mean 'ellipse'?" in msg and "evaluate --list" in msg
+    assert "did you mean 'hexagon'?" in msg and "evaluate --list" in msg
     assert ", ".join(sorted(SHIPPED_AGENTS)) in msg
     assert "agents/models" not in msg  # no path that only a clone has
+
+
+@pytest.mark.parametrize("name", sorted(RETIRED_AGENTS))
+def test_a_retired_agent_is_not_installed_and_its_name_says_what_replaces_it(name, tmp_path,
+                                                                             monkeypatch):
+    assert name not in SHIPPED_AGENTS and name not in shipped_agents()
+    assert not (shipped_models_dir() / f"{name}.zip").exists()
+    for spec in (name, f"{name}.zip"):
+        with pytest.raises(GraspGaitInputError) as err:
+            resolve_model(spec)
+        msg = str(err.value)
+        assert f"MODEL {name!r}: the shipped agent {name!r} was retired after" in msg
+        assert f"graspgait evaluate general --object {name}" in msg
+        assert f"graspgait train {name}" in msg
+    # its recipe stays bundled, and a file of that name in the working folder still wins
+    assert load_train_config(name).env_kwargs["object"] == name
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / f"{name}.zip").write_bytes(b"")
+    assert resolve_model(name) == Path(f"{name}.zip")
 
 
 def test_load_agent_takes_a_name_and_its_zip_loads_without_the_loader():

@@ -15,8 +15,8 @@ from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.registry import default_start
 from graspgait_env.planners.rule_based import rule_based
 
-ELLIPSE = (Path(__file__).resolve().parents[2] / "graspgait_env" / "agents" / "models"
-           / "ellipse.zip")
+GENERAL = (Path(__file__).resolve().parents[2] / "graspgait_env" / "agents" / "models"
+           / "general.zip")
 
 
 @pytest.fixture(scope="module")
@@ -24,12 +24,14 @@ def story(tmp_path_factory):
     import torch
 
     torch.set_num_threads(1)
-    return tell_story(ELLIPSE, tmp_path_factory.mktemp("story"))  # the demo's story
+    return tell_story(GENERAL, tmp_path_factory.mktemp("story"))  # the demo's story
 
 
-def test_the_shipped_ellipse_agent_tells_the_demo_story(story):
+def test_the_shipped_general_agent_tells_the_demo_story(story):
+    """``general`` on its env's default object, the ellipse, as ``make demo`` plays it."""
     rows, files = story["rows"], story["files"]
-    model, start, _, _ = learned_gait(ELLIPSE)  # the model card's gait model and start
+    model, start, _, _ = learned_gait(GENERAL)  # the model card's gait model and start
+    assert model.shape.name == "ellipse" and model.contact_model.name == "hand"
     assert start == default_start(model)
     assert rows["optimal"]["regrasps"] == optimal_gait(model, start, 360.0).regrasps
     assert rows["rule-based"]["regrasps"] == rule_based(model, start, 360.0).regrasps
@@ -60,9 +62,9 @@ def test_table_rows_and_ratio():
 
 
 def test_cli_story_writes_the_files_and_bad_start_exits_2(tmp_path, capsys):
-    model, start, _, _ = learned_gait(ELLIPSE)
+    model, start, _, _ = learned_gait(GENERAL)
     phis = ",".join(f"{model.contact_deg(start.contacts[f]):g}" for f in start.held())
-    rc = main(["story", "ellipse", "--start", phis, "--out", str(tmp_path)])
+    rc = main(["story", "--start", phis, "--out", str(tmp_path)])  # MODEL: general
     out = capsys.readouterr().out
     assert rc == 0, out
     assert "| optimal | yes |" in out
@@ -70,8 +72,11 @@ def test_cli_story_writes_the_files_and_bad_start_exits_2(tmp_path, capsys):
     for argv, needle in ((["--start", "50"], "--start '50'"),
                          (["--mu", "-1"], "--mu"),
                          (["--start", "50,60"], "both contacts lie in finger 1")):
-        rc = main(["story", str(ELLIPSE), "--out", str(tmp_path), *argv])
+        rc = main(["story", str(GENERAL), "--out", str(tmp_path), *argv])
         err = capsys.readouterr().err.strip().splitlines()
         assert rc == 2 and len(err) == 1 and needle in err[0], (argv, err)
     rc = main(["story", str(tmp_path / "none.zip"), "--out", str(tmp_path)])
     assert rc == 2 and "no such file" in capsys.readouterr().err
+    rc = main(["story", "ellipse", "--out", str(tmp_path)])  # a retired agent's name
+    err = capsys.readouterr().err
+    assert rc == 2 and "was retired after" in err and "story general --object ellipse" in err

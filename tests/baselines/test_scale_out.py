@@ -125,8 +125,8 @@ def test_bench_agents_on_ray_gives_the_serial_rows(local_ray):
     from graspgait_env.agents.bench import find_agents, run_agent_bench
     from graspgait_env.agents.ray_train import bench_agents_on_ray
 
-    agents, _ = find_agents("circle,pentagon")
-    args = (agents, ["pentagon", "circle"], [0.7], 2)
+    agents, _ = find_agents("circle,hexagon")
+    args = (agents, ["hexagon", "circle"], [0.7], 2)
     serial = run_agent_bench(*args, progress=False)
     cases, failures = bench_agents_on_ray(*args, progress=False)
     assert failures == []
@@ -138,13 +138,13 @@ def test_bench_agents_on_ray_gives_the_serial_rows(local_ray):
 def test_cli_bench_ray_with_an_agent_writes_the_serial_json(local_ray, tmp_path, capsys):
     import json
 
-    argv = ["bench", "--objects", "pentagon", "--mus", "0.7", "--planners", "rule",
-            "--starts", "1", "--agents", "pentagon"]
+    argv = ["bench", "--objects", "hexagon", "--mus", "0.7", "--planners", "rule",
+            "--starts", "1", "--agents", "hexagon"]
     assert main([*argv, "--json", str(tmp_path / "serial.json")]) == 0
     assert main([*argv, "--ray", "--json", str(tmp_path / "ray.json")]) == 0
     capsys.readouterr()
     serial, on_ray = (json.loads((tmp_path / f).read_text()) for f in ("serial.json", "ray.json"))
-    assert any("agent:pentagon" in json.dumps(c) for c in serial["runs"])
+    assert any("agent:hexagon" in json.dumps(c) for c in serial["runs"])
     assert _no_wall(on_ray) == _no_wall(serial)
 
 

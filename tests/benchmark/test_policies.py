@@ -28,12 +28,15 @@ def test_policy_names_resolve():
         with pytest.raises(GraspGaitInputError, match="depth D of greedy-reach:D is 1 to 5"):
             parse_policy(bad)
     assert parse_policy("agent:random").kind == "agent"  # the shipped agent, not the policy
-    ellipse = parse_policy("ellipse")
-    assert ellipse.kind == "agent" and ellipse.arg.endswith("ellipse.zip")
+    hexagon = parse_policy("hexagon")
+    assert hexagon.kind == "agent" and hexagon.arg.endswith("hexagon.zip")
+    for retired in ("ellipse", "agent:pentagon"):  # retired agents: the error says so
+        with pytest.raises(GraspGaitInputError, match=r"was retired after .*use general"):
+            parse_policy(retired)
     assert parse_policy("config:smoke").label == "config-smoke"
     assert parse_policy("bc").arg == "optimal" and parse_policy("bc:rule").label == "bc-rule"
     with pytest.raises(GraspGaitInputError, match="did you mean"):
-        parse_policy("agent:elipse")
+        parse_policy("agent:hexagn")
     with pytest.raises(GraspGaitInputError, match="not a bundled training config"):
         parse_policy("config:nope")
 
@@ -81,9 +84,9 @@ def test_a_shipped_agent_on_its_task(tmp_path):
 
 
 def test_an_agent_on_the_named_parts_is_scored(tmp_path):
-    """The shipped ellipse reads a Dict observation (observation_mode: dict): its cells
+    """The shipped general reads a Dict observation (observation_mode: dict): its cells
     run, and the task's env keeps the agent's parts."""
-    row = run_benchmark("agent:ellipse", parse_tasks("map-hand-ellipse"), [0],
+    row = run_benchmark("agent:general", parse_tasks("map-hand-ellipse"), [0],
                         out_dir=tmp_path / "e", episodes=2, progress=False, reps=100)
     assert not row["failures"], row["failures"]
     cell = row["cells"][0]

@@ -130,7 +130,7 @@ for name in hands:
     load_hand(name, gg.load_object("ellipse"))
 assert bundled_names("sim") == ["default"]
 cfg = load_sim_config()
-model, card = load_agent("ellipse")
+model, card = load_agent("hexagon")
 assert card["env_id"] == "GraspGait-v0", card
 print("objects", len(names), "hands", len(hands), "agents", ",".join(shipped_agents()))
 """
@@ -165,9 +165,9 @@ KITE = ("name: kite\ntype: polygon\n"
 
 
 @pytest.mark.parametrize("argv", [
-    ["evaluate", "ellipse", "--episodes", "3"],
+    ["evaluate", "hexagon", "--episodes", "3"],
     ["evaluate", "random", "--object", "kite.yaml", "--episodes", "3"],
-    ["story", "ellipse"],
+    ["story", "general"],
     ["bench", "--agents", "shipped", "--objects", "pentagon", "--starts", "2"],
     ["evaluate", "--list"],
     ["config", "sim", "default"],
@@ -249,7 +249,7 @@ def test_base_install_makes_every_env_and_names_a_missing_extra(wheel: Path,
     assert not (Path(site) / "agents").exists() and not (Path(site) / "baselines").exists()
     script = env_dir / "bin" / "graspgait"
     for argv, extra in ((["train", "smoke"], "train"),
-                        (["evaluate", "ellipse", "--episodes", "1"], "train"),
+                        (["evaluate", "hexagon", "--episodes", "1"], "train"),
                         (["bench", "--starts", "1", "--ray"], "ray")):
         r = subprocess.run([str(script), *argv], cwd=work, env=clean, capture_output=True,
                            text=True, timeout=600)
