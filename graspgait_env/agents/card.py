@@ -268,7 +268,7 @@ def load_agent(model_path: str | os.PathLike[str], device: str = "cpu") -> tuple
     Parameters
     ----------
     model_path
-        A shipped agent's name (``"ellipse"``; :func:`shipped_agents`) or the path of a
+        A shipped agent's name (``"general"``; :func:`shipped_agents`) or the path of a
         model zip (``.zip`` may be left out). A model saved by graspgait_env 0.1 (whose
         pickles and card name the packages ``agents`` / ``baselines``) loads too
         (:mod:`graspgait_env.agents.legacy`).
