@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import shlex
 import sys
 import textwrap
 from collections.abc import Callable, Sequence
@@ -886,6 +887,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
                           progress=not args.quiet, audit=args.audit,
                           batched=not args.one_by_one)
     print(format_evaluation(result))
+    result["command"] = shlex.join(
+        [PROG, "evaluate", args.model]
+        + (["--env", args.env] if args.env else [])
+        + (["--object", args.object] if args.object else [])
+        + (["--mu", f"{mu:g}"] if mu is not None else [])
+        + ["--episodes", str(args.episodes)] + (["--seed", str(args.seed)] if args.seed else [])
+        + [x for s in args.set or [] for x in ("--set", s)]
+        + (["--audit"] if args.audit else []))
     if args.json:
         _write_output("--json", args.json, lambda: write_evaluation(result, args.json))
         print(f"wrote {args.json}")
@@ -922,7 +931,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="an env keyword argument (YAML value), e.g. bundled_fraction=0; "
                    "repeatable")
-    p.add_argument("--json", metavar="FILE", help="write the result JSON (per-episode records)")
+    p.add_argument("--json", metavar="FILE",
+                   help="write the result JSON (per-episode records and the command line; "
+                   "`graspgait card --evaluation` reads it)")
     p.add_argument("--audit", action="store_true",
                    help="price every move against the optimum: where the regrasps beyond "
                    "it go (idle regrasps, losing regrasps, losing rotations)")
@@ -985,7 +996,8 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
 def _cmd_card(args: argparse.Namespace) -> int:
     from graspgait_env.agents.hub_card import write_hub_card
 
-    text = write_hub_card(args.models, args.out, args.title, args.benchmark or ())
+    text = write_hub_card(args.models, args.out, args.title, args.benchmark or (),
+                          args.against or (), args.evaluation or ())
     if args.out is None:
         sys.stdout.write(text)
     else:
@@ -1006,6 +1018,9 @@ def _add_card(sub: argparse._SubParsersAction) -> None:
                        epilog=_epilog(["card runs/*general*/model.zip --out README.md",
                                        "card general runs/general-s1/model.zip "
                                        "--benchmark bench/agent --benchmark bench/seeds",
+                                       "card circle --benchmark bench/agent-circle "
+                                       "--benchmark bench/config-circle "
+                                       "--against general=bench/general-circle",
                                        "card hexagon"], duration="a second"))
     p.add_argument("models", metavar="MODEL", nargs="+",
                    help="saved models (zips with their cards) or shipped agents' names")
@@ -1016,6 +1031,16 @@ def _add_card(sub: argparse._SubParsersAction) -> None:
                    "to the card; repeatable: with the shipped run's row (agent:NAME) and the "
                    "retrained recipe's (RUNS/s{seed}/model.zip or config:NAME) the card says "
                    "whether the recipe retrained is worse")
+    p.add_argument("--against", metavar="[NAME=]DIR", action="append",
+                   help="another recipe's `graspgait benchmark` row on the same tasks and "
+                   "seeds (e.g. general=bench/general-circle: the five general models on the "
+                   "circle's tasks); repeatable: the card says whether this recipe is better "
+                   "(its IQM above the upper end of the other's 95%% interval), worse or not "
+                   "measurably different")
+    p.add_argument("--evaluation", metavar="FILE", action="append",
+                   help="a `graspgait evaluate MODEL ... --json FILE` result of one of these "
+                   "models; repeatable: each a row of the card's measured results, with the "
+                   "command that made it")
     p.set_defaults(func=_cmd_card)
 
 

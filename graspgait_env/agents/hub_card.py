@@ -32,7 +32,16 @@ with their 95% stratified bootstrap intervals and the IQM per track. Where one r
 shipped run (``agent:NAME``) and another the recipe retrained over seeds (a model
 template ``RUNS/s{seed}/model.zip`` or ``config:NAME``), on the same tasks and seeds, the
 card says whether the retrained recipe's IQM is below the shipped run's: then it is
-**worse**, however little (the benchmark's rule, docs/benchmark.md).
+**worse**, however little (the benchmark's rule, docs/benchmark.md). Below the table, each
+row's per-task figures as mean +/- std over its seeds (success over the starts with a
+gait, the regrasps over the optimum's, the score), read from the row's cells.
+
+``--against [NAME=]DIR`` adds another recipe's row on the same tasks and seeds (e.g. the
+one agent ``general``'s five models on a per-object agent's tasks) and says how this
+recipe compares with it: its retrained row's IQM (the shipped run's without one) is
+**better** when it lies above the upper end of the other row's 95% interval, **worse**
+when below the lower end, and else not measurably different. This is the rule by which a
+per-object agent stays shipped beside ``general`` (docs/agents.md).
 """
 
 from __future__ import annotations
@@ -49,7 +58,8 @@ import yaml
 
 from graspgait_env.errors import GraspGaitInputError
 
-__all__ = ["METRICS", "benchmark_section", "hub_card", "metric_stats", "write_hub_card"]
+__all__ = ["METRICS", "benchmark_section", "compare_rows", "evaluation_section", "hub_card",
+           "metric_stats", "task_stats", "write_hub_card"]
 
 #: (key in a card's ``eval``, name in the card, scale, format) of each metric.
 METRICS: tuple[tuple[str, str, float, str], ...] = (
@@ -86,7 +96,9 @@ def _stat(values: Sequence[float], scale: float, fmt: str) -> str:
 def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None = None,
              title: str | None = None,
              benchmarks: Sequence[Mapping[str, Any]] = (),
-             benchmark_names: Sequence[str] | None = None) -> str:
+             benchmark_names: Sequence[str] | None = None,
+             against: Sequence[tuple[str, Mapping[str, Any]]] = (),
+             evaluations: Sequence[Mapping[str, Any]] = ()) -> str:
     """The Markdown model card (Hugging Face front matter first) of one recipe's runs.
 
     Parameters
@@ -102,6 +114,13 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     benchmarks, benchmark_names
         ``graspgait benchmark`` rows' ``result.json`` to add as a ``## Benchmark``
         section (:func:`benchmark_section`), and how errors name them.
+    against
+        ``(name, result.json)`` of other recipes' rows on the same tasks and seeds, to
+        compare this recipe with (module docstring; needs ``benchmarks``).
+    evaluations
+        ``graspgait evaluate --json`` results of these models, each a row of a
+        ``## Measured results`` table with the command that made it
+        (:func:`evaluation_section`).
 
     Returns
     -------
@@ -187,6 +206,8 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
                      f"{'' if wall is None else f'{float(wall):.0f}'} | "
                      f"{100.0 * ev['success_rate_solvable']:.1f} | "
                      f"{ev['regrasps_vs_optimal']:.3f} |")
+    if evaluations:
+        lines += evaluation_section(evaluations)
     hyper = {k: cfg[k] for k in ("policy", "policy_kwargs", "net_arch", "features_extractor",
                                  "features_extractor_kwargs", "imitation", "n_envs",
                                  "n_steps", "batch_size", "n_epochs", "learning_rate",
@@ -199,8 +220,12 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
                  + (" --ray" if n > 1 else ""))
     lines.append("graspgait card RUN_ROOT/*/model.zip --out README.md")
     lines += ["```"]
+    if against and not benchmarks:
+        raise GraspGaitInputError(
+            "--against: give this recipe's own rows too (--benchmark DIR: the shipped run's "
+            "row agent:NAME, the retrained recipe's config:NAME); the comparison is theirs")
     if benchmarks:
-        lines += benchmark_section(benchmarks, benchmark_names)
+        lines += benchmark_section(benchmarks, benchmark_names, against)
     lines += ["", "## Use", "", "```bash",
               f"graspgait evaluate {shlex.quote(names[0])} --episodes 100", "```", "",
               "```python", "from graspgait_env.agents.card import load_agent",
@@ -208,6 +233,75 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
               "## Versions", ""]
     lines += [f"- {k}: {v}" for k, v in (first.get("versions") or {}).items()]
     return "\n".join(lines) + "\n"
+
+
+def _num(x: Any, spec: str) -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def _rule_starts(res: Mapping[str, Any]) -> str:
+    # how many of the starts with a gait the rule-based mean is over, where not all
+    share, n = res.get("rule_success_rate_solvable"), int(res.get("solvable_episodes") or 0)
+    if share is None or res.get("mean_rule_regrasps") is None or round(share * n) == n:
+        return ""
+    k = round(share * n)
+    return f" ({k} start{'s' if k != 1 else ''})"
+
+
+def evaluation_section(results: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The card's ``## Measured results`` lines: one table row per ``graspgait evaluate
+    --json`` result (the env, object, mu and contact model; the success over all episodes
+    and over the starts with a gait; the agent's, the optimum's and the rule-based gait's
+    mean regrasps over the agent's successes, with the ratios), then the commands.
+
+    Raises
+    ------
+    GraspGaitInputError
+        A result without the summary of :func:`graspgait_env.agents.evaluate.evaluate`
+        or without the command line that ``graspgait evaluate`` records.
+    """
+    need = ("env_id", "n_episodes", "success_rate", "success_rate_solvable",
+            "solvable_episodes", "mean_regrasps", "regrasps_vs_optimal", "command")
+    for i, res in enumerate(results):
+        missing = [k for k in need if k not in res]
+        if missing:
+            raise GraspGaitInputError(
+                f"--evaluation {i + 1}: no {', '.join(missing)} in it; give the JSON that "
+                "`graspgait evaluate MODEL ... --json FILE` writes")
+    lines = ["", "## Measured results", "",
+             "| evaluation | episodes | success (all) | success (starts with a gait) | "
+             "regrasps | optimum's | x optimum | rule-based's | x rule-based |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for res in results:
+        mu = res.get("mu")
+        where = (f"{res['env_id']}, {res.get('object') or 'an object per episode'}, mu "
+                 f"{'per episode' if mu is None else format(mu, 'g')}, contact "
+                 f"{res.get('contact_model') or 'per object'}")
+        lines.append(
+            f"| {where} | {res['n_episodes']} | {_num(res['success_rate'], '.1%')} | "
+            f"{_num(res['success_rate_solvable'], '.1%')} ({res['solvable_episodes']}) | "
+            f"{_num(res['mean_regrasps'], '.2f')} | "
+            f"{_num(res.get('mean_optimal_regrasps'), '.2f')} | "
+            f"{_num(res['regrasps_vs_optimal'], '.3f')} | "
+            f"{_num(res.get('mean_rule_regrasps'), '.2f')}{_rule_starts(res)} | "
+            f"{_num(res.get('regrasps_vs_rule'), '.3f')} |")
+    lines += ["", "Regrasps: means over the agent's successful episodes; the optimum's (the "
+              "exact planner) and the rule-based gait's (thesis 6.5) from the same starts, "
+              "the rule-based mean over the episodes where it also found a gait. Each row "
+              "is `graspgait evaluate` of this card's model, written with `--json` and "
+              "read back by `graspgait card --evaluation`:", "", "```bash"]
+    lines += [str(res["command"]) for res in results]
+    lines += ["```"]
+    for res in results:
+        a = res.get("audit")
+        if a:
+            lines += ["", f"Where the regrasps beyond the optimum go (`{res['command']}`): "
+                      f"{a['excess_regrasps']} over {a['episodes']} successful episodes = "
+                      f"{a['idle_regrasps']} idle regrasps (the goal no closer) + "
+                      f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing "
+                      f"regrasps + {a['excess_of_losing_rotations']} from "
+                      f"{a['losing_rotations']} losing rotations."]
+    return lines
 
 
 _SHIPPED_KINDS = ("agent",)  # a benchmark row of the one shipped run
@@ -219,8 +313,52 @@ def _ci(block: Mapping[str, Any], key: str) -> str:
     return f"{100.0 * block[key]:.1f} [{100.0 * lo:.1f}, {100.0 * hi:.1f}]"
 
 
+def task_stats(result: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Per task of a ``graspgait benchmark`` row, mean and std over its seeds (``ddof =
+    0``) of the success over the starts with a gait, of the regrasps over the optimum's
+    on the successes (``1 / efficiency``) and of the score, read from the row's
+    ``cells``.
+
+    Returns
+    -------
+    list of dict
+        One per task, in the row's order: ``task``, ``runs`` (seeds with a start with a
+        gait), and ``success``, ``ratio``, ``score``, each ``(mean, std)`` or None (no
+        seed with a figure). A seed without a success has no ratio and scores 0.
+    """
+    out = []
+    for task in result.get("tasks") or []:
+        cells = [c["summary"] for c in result.get("cells") or []
+                 if c.get("task") == task and (c.get("summary") or {}).get("success")
+                 is not None]
+        ratios = [1.0 / c["efficiency"] for c in cells if c.get("efficiency")]
+        out.append({"task": task, "runs": len(cells),
+                    **{k: metric_stats(v) if v else None for k, v in (
+                        ("success", [c["success"] for c in cells]),
+                        ("ratio", ratios),
+                        ("score", [c["score"] for c in cells]))}})
+    return out
+
+
+def compare_rows(ours: Mapping[str, Any], other: Mapping[str, Any]) -> tuple[str, float]:
+    """How the suite IQM of row ``ours`` stands against row ``other``'s 95% interval:
+    ``("better", d)`` above its upper end, ``("worse", d)`` below its lower end, else
+    ``("not measurably different", d)``; ``d`` is the difference of the IQMs (ours minus
+    other's, as fractions)."""
+    a = float(ours["aggregate"]["overall"]["iqm"])
+    b = other["aggregate"]["overall"]
+    lo, hi = (float(x) for x in b["iqm_ci"])
+    verdict = "better" if a > hi else "worse" if a < lo else "not measurably different"
+    return verdict, a - float(b["iqm"])
+
+
+def _pm(stat: tuple[float, float] | None, scale: float, fmt: str) -> str:
+    return "-" if stat is None else f"{stat[0] * scale:{fmt}} +/- {stat[1] * scale:{fmt}}"
+
+
 def benchmark_section(results: Sequence[Mapping[str, Any]],
-                      names: Sequence[str] | None = None) -> list[str]:
+                      names: Sequence[str] | None = None,
+                      against: Sequence[tuple[str, Mapping[str, Any]]] = ()) -> list[str]:
     """The card's ``## Benchmark`` lines from ``graspgait benchmark`` rows (module
     docstring).
 
@@ -229,9 +367,12 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
     results
         Each row's ``result.json`` (keys ``policy``, ``spec``, ``suite_version``,
         ``tasks``, ``seeds``, ``command``, ``date``, ``run_wall_s``, ``aggregate`` with
-        ``overall`` and ``tracks``).
+        ``overall`` and ``tracks``, and ``cells`` for the per-task figures).
     names
         How each row is named in errors (its folder, usually).
+    against
+        ``(name, result.json)`` of other recipes' rows on the same tasks and seeds: the
+        section says how this recipe compares with each (:func:`compare_rows`).
 
     Raises
     ------
@@ -240,21 +381,31 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
         seeds.
     """
     names = list(names) if names is not None else [f"row {i + 1}" for i in range(len(results))]
-    for res, name in zip(results, names, strict=True):
+    rows = [*zip(names, results, strict=True),
+            *((f"--against {n}", r) for n, r in against)]
+    for name, res in rows:
         if not isinstance(res.get("aggregate"), Mapping) or "overall" not in res["aggregate"]:
+            what = name if name.startswith("--against") else f"--benchmark {name}"
             raise GraspGaitInputError(
-                f"--benchmark {name}: no suite aggregate in its result.json; give the folder "
+                f"{what}: no suite aggregate in its result.json; give the folder "
                 "of a finished `graspgait benchmark` row (its --out)")
     first = results[0]
-    for res, name in zip(results[1:], names[1:], strict=True):
+    for name, res in rows[1:]:
         for key in ("suite_version", "tasks", "seeds"):
             if res.get(key) != first.get(key):
+                what = name if name.startswith("--against") else f"--benchmark {name}"
                 raise GraspGaitInputError(
-                    f"--benchmark {name}: its {key} {res.get(key)!r} differs from "
+                    f"{what}: its {key} {res.get(key)!r} differs from "
                     f"{names[0]}'s {first.get(key)!r}; rows compared in a card share the "
                     "suite, the tasks and the seeds")
-    tracks = list(dict.fromkeys(t for r in results for t in r["aggregate"].get("tracks", {})))
+    every = [*results, *(r for _, r in against)]
+    tracks = list(dict.fromkeys(t for r in every for t in r["aggregate"].get("tracks", {})))
     seeds = ",".join(str(s) for s in first.get("seeds") or [])
+    kinds = {"agent": " (the shipped run)", "agent-template": " (retrained per seed)",
+             "config": " (retrained per seed)"}
+    labels = [f"`{r.get('policy')}`"
+              + kinds.get(str((r.get("spec") or {}).get("kind")), "") for r in results]
+    labels += [f"`{n}` (against)" for n, _ in against]
     lines = ["", f"## Benchmark (suite v{first.get('suite_version')}, seeds {seeds})", "",
              "Score in percent (success x efficiency) over the benchmark's test starts; "
              "IQM and mean over the (run, task) scores with 95% stratified bootstrap "
@@ -262,15 +413,12 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
              "| row | tasks | IQM [95% CI] | mean [95% CI] | "
              + " | ".join(f"{t} IQM" for t in tracks) + " | wall time (s) | date | command |",
              "|---|---:|---|---|" + "---|" * len(tracks) + "---:|---|---|"]
-    for res in results:
+    for res, label in zip(every, labels, strict=True):
         agg = res["aggregate"]
         per = [_ci(agg["tracks"][t], "iqm") if t in agg.get("tracks", {}) else "-"
                for t in tracks]
         wall = res.get("run_wall_s")
-        what = {"agent": " (the shipped run)", "agent-template": " (retrained per seed)",
-                "config": " (retrained per seed)"}.get(str((res.get("spec") or {}).get("kind")),
-                                                      "")
-        lines.append(f"| `{res.get('policy')}`{what} | {agg['overall'].get('tasks')} | "
+        lines.append(f"| {label} | {agg['overall'].get('tasks')} | "
                      f"{_ci(agg['overall'], 'iqm')} | {_ci(agg['overall'], 'mean')} | "
                      + " | ".join(per) + f" | {'' if wall is None else f'{float(wall):.0f}'}"
                      f" | {res.get('date', '')} | `{res.get('command', '')}` |")
@@ -285,30 +433,93 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
         lines += ["", f"Retrained over the seeds, the recipe is {verdict}: IQM "
                   f"{100.0 * b:.1f} against {100.0 * a:.1f} "
                   f"({100.0 * (b - a):+.1f} points)."]
+    ours = (retrained or shipped or list(results))[0]
+    which = ("retrained over the seeds" if retrained else "the shipped run" if shipped
+             else f"`{ours.get('policy')}`")
+    for name, other in against:
+        verdict, diff = compare_rows(ours, other)
+        lo, hi = other["aggregate"]["overall"]["iqm_ci"]
+        how = {"better": f"above the upper end of its 95% interval [{100.0 * lo:.1f}, "
+                         f"{100.0 * hi:.1f}]",
+               "worse": f"below the lower end of its 95% interval [{100.0 * lo:.1f}, "
+                        f"{100.0 * hi:.1f}]"}.get(
+            verdict, f"within its 95% interval [{100.0 * lo:.1f}, {100.0 * hi:.1f}]")
+        lines += ["", f"Against `{name}` on the same tasks and seeds, this recipe "
+                  f"({which}) is **{verdict}**: IQM "
+                  f"{100.0 * ours['aggregate']['overall']['iqm']:.1f} against "
+                  f"{100.0 * other['aggregate']['overall']['iqm']:.1f} "
+                  f"({100.0 * diff:+.1f} points), {how}."]
+    per_task = [(label, task_stats(r)) for label, r in zip(labels, every, strict=True)
+                if r.get("cells")]
+    if per_task:
+        lines += ["", "Per task, mean +/- std over the seeds (success over the starts with a "
+                  "gait; regrasps over the optimum's on the successes; score):", "",
+                  "| task | row | seeds | success (%) | regrasps / optimum | score (%) |",
+                  "|---|---|---:|---|---|---|"]
+        for task in first.get("tasks") or []:
+            for label, stats in per_task:
+                st = next((x for x in stats if x["task"] == task), None)
+                if st is None or not st["runs"]:
+                    continue
+                lines.append(f"| {task} | {label} | {st['runs']} | "
+                             f"{_pm(st['success'], 100.0, '.1f')} | "
+                             f"{_pm(st['ratio'], 1.0, '.3f')} | "
+                             f"{_pm(st['score'], 100.0, '.1f')} |")
     return lines
 
 
 def write_hub_card(models: Sequence[str | os.PathLike[str]],
                    out: str | os.PathLike[str] | None = None,
                    title: str | None = None,
-                   benchmarks: Sequence[str | os.PathLike[str]] = ()) -> str:
+                   benchmarks: Sequence[str | os.PathLike[str]] = (),
+                   against: Sequence[str] = (),
+                   evaluations: Sequence[str | os.PathLike[str]] = ()) -> str:
     """:func:`hub_card` of the saved models ``models`` (zips with their JSON cards), with
     the ``graspgait benchmark`` row folders ``benchmarks`` (each with its
-    ``result.json``); written atomically to ``out`` when given. Returns the card."""
+    ``result.json``) and the other recipes' row folders ``against``, each ``NAME=DIR`` or
+    ``DIR`` (named by its folder), and the ``graspgait evaluate --json`` files
+    ``evaluations`` (of these models; another model's is refused); written atomically to
+    ``out`` when given. Returns the card."""
     from graspgait_env.agents.card import read_card, resolve_model
     from graspgait_env.atomic import write_text_atomic
 
     paths = [resolve_model(m) for m in models]
-    rows = []
-    for d in benchmarks:
+    def row(flag: str, d: str | os.PathLike[str]) -> dict[str, Any]:
         path = Path(d) / "result.json"
         if not path.is_file():
             raise GraspGaitInputError(
-                f"--benchmark {d}: no result.json there; give the folder of a finished "
+                f"{flag} {d}: no result.json there; give the folder of a finished "
                 "`graspgait benchmark` row (its --out)")
-        rows.append(json.loads(path.read_text(encoding="utf-8")))
+        return json.loads(path.read_text(encoding="utf-8"))
+
+    rows = [row("--benchmark", d) for d in benchmarks]
+    others = []
+    for item in against:
+        name, sep, folder = str(item).partition("=")
+        if not sep:
+            name, folder = Path(item).name, str(item)
+        if not name or not folder:
+            raise GraspGaitInputError(
+                f"--against {item!r}: give NAME=DIR or DIR, e.g. --against "
+                "general=bench/general-circle")
+        others.append((name, row("--against", folder)))
+    evals = []
+    for f in evaluations:
+        path = Path(f)
+        if not path.is_file():
+            raise GraspGaitInputError(
+                f"--evaluation {f}: no such file; give the JSON that `graspgait evaluate "
+                "MODEL ... --json FILE` writes")
+        res = json.loads(path.read_text(encoding="utf-8"))
+        model = (res.get("model") or {}).get("path")
+        if model is None or resolve_model(model) not in paths:
+            raise GraspGaitInputError(
+                f"--evaluation {f}: an evaluation of {model!r}, not of this card's models "
+                f"({', '.join(str(m) for m in models)}); evaluate one of them")
+        evals.append(res)
     text = hub_card([read_card(p) for p in paths], names=[str(m) for m in models],
-                    title=title, benchmarks=rows, benchmark_names=[str(d) for d in benchmarks])
+                    title=title, benchmarks=rows, benchmark_names=[str(d) for d in benchmarks],
+                    against=others, evaluations=evals)
     if out is not None:
         write_text_atomic(Path(out), text)
     return text

@@ -118,3 +118,106 @@ def test_benchmark_rows_say_when_the_retrained_recipe_is_worse():
 def test_card_command_refuses_a_benchmark_folder_without_a_result(tmp_path, capsys):
     assert main(["card", "circle", "--benchmark", str(tmp_path)]) == 2
     assert "no result.json there" in capsys.readouterr().err
+
+
+def _cell(task: str, seed: int, success: float, efficiency: float | None) -> dict:
+    score = success * efficiency if efficiency is not None else 0.0
+    return {"task": task, "seed": seed,
+            "summary": {"success": success, "efficiency": efficiency, "score": score}}
+
+
+def test_per_task_figures_are_mean_and_std_over_the_seeds():
+    from graspgait_env.agents.hub_card import task_stats
+
+    row = _row("config", 0.9)
+    # by hand, map-hand-circle: success 1.0, 0.8 -> 90 +/- 10 %; ratio 1/0.8 = 1.25 and
+    # 1/1.0 = 1 -> 1.125 +/- 0.125; score 0.8, 0.8 -> 80 +/- 0. random-l1: seed 1 has no
+    # success (no ratio, score 0): ratio over seed 0 alone, score 0.5, 0 -> 25 +/- 25
+    row["cells"] = [_cell("map-hand-circle", 0, 1.0, 0.8), _cell("map-hand-circle", 1, 0.8, 1.0),
+                    _cell("random-l1", 0, 0.5, 1.0), _cell("random-l1", 1, 0.0, None)]
+    stats = {s["task"]: s for s in task_stats(row)}
+    assert stats["map-hand-circle"]["success"] == pytest.approx((0.9, 0.1))
+    assert stats["map-hand-circle"]["ratio"] == pytest.approx((1.125, 0.125))
+    assert stats["random-l1"]["ratio"] == pytest.approx((1.0, 0.0))
+    assert stats["random-l1"]["score"] == pytest.approx((0.25, 0.25))
+    text = hub_card([_run(0, 1.0, 1.0, 400.0)], benchmarks=[row])
+    assert ("| map-hand-circle | `config-general` (retrained per seed) | 2 | 90.0 +/- 10.0 | "
+            "1.125 +/- 0.125 | 80.0 +/- 0.0 |") in text
+    assert ("| random-l1 | `config-general` (retrained per seed) | 2 | 25.0 +/- 25.0 | "
+            "1.000 +/- 0.000 | 25.0 +/- 25.0 |") in text
+
+
+def test_against_another_recipe_says_better_only_above_its_interval():
+    from graspgait_env.agents.hub_card import compare_rows
+
+    ours, shipped = _row("config", 0.99), _row("agent", 0.995)
+    rival = _row("agent-template", 0.96)  # its IQM interval [0.95, 0.96]
+    assert compare_rows(ours, rival) == ("better", pytest.approx(0.03))
+    assert compare_rows(_row("config", 0.955), rival)[0] == "not measurably different"
+    assert compare_rows(_row("config", 0.94), rival)[0] == "worse"
+    text = hub_card([_run(0, 1.0, 1.0, 400.0)], names=["circle"],
+                    benchmarks=[shipped, ours], against=[("general", rival)])
+    assert "| `general` (against) | 2 | 96.0 [95.0, 96.0] |" in text
+    assert ("Against `general` on the same tasks and seeds, this recipe (retrained over the "
+            "seeds) is **better**: IQM 99.0 against 96.0 (+3.0 points), above the upper end "
+            "of its 95% interval [95.0, 96.0].") in text
+    # without a retrained row the shipped run is compared
+    alone = hub_card([_run(0, 1.0, 1.0, 400.0)], benchmarks=[_row("agent", 0.955)],
+                     against=[("general", rival)])
+    assert ("this recipe (the shipped run) is **not measurably different**: IQM 95.5 "
+            "against 96.0 (-0.5 points), within its 95% interval [95.0, 96.0]") in alone
+    with pytest.raises(GraspGaitInputError, match="--against general: its seeds"):
+        hub_card([_run(0, 1.0, 1.0, 400.0)], benchmarks=[ours],
+                 against=[("general", _row("agent-template", 0.9, (0,)))])
+    with pytest.raises(GraspGaitInputError, match="give this recipe's own rows too"):
+        hub_card([_run(0, 1.0, 1.0, 400.0)], against=[("general", rival)])
+
+
+def test_card_command_reads_against_rows_by_name_or_folder(tmp_path, capsys):
+    import json
+
+    for name, row in (("agent-circle", _row("agent", 0.99)), ("general-circle",
+                                                              _row("agent-template", 0.5))):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "result.json").write_text(json.dumps(row), encoding="utf-8")
+    bench = ["--benchmark", str(tmp_path / "agent-circle")]
+    assert main(["card", "circle", *bench, "--against",
+                 f"general={tmp_path / 'general-circle'}"]) == 0
+    assert "Against `general` on the same tasks" in capsys.readouterr().out
+    assert main(["card", "circle", *bench, "--against", str(tmp_path / "general-circle")]) == 0
+    assert "Against `general-circle` on the same tasks" in capsys.readouterr().out
+    assert main(["card", "circle", *bench, "--against", f"general={tmp_path}"]) == 2
+    assert "--against" in capsys.readouterr().err
+
+
+def test_evaluations_are_rows_with_the_commands_that_made_them(tmp_path, capsys):
+    import json
+
+    f = tmp_path / "eval.json"
+    assert main(["evaluate", "circle", "--episodes", "2", "--seed", "5", "--set",
+                 "forbid_reversal=true", "--json", str(f), "--quiet"]) == 0
+    capsys.readouterr()
+    res = json.loads(f.read_text(encoding="utf-8"))
+    assert res["command"] == ("graspgait evaluate circle --episodes 2 --seed 5 --set "
+                              "forbid_reversal=true")
+    assert main(["card", "circle", "--evaluation", str(f)]) == 0
+    text = capsys.readouterr().out
+    ratio = f"{res['regrasps_vs_optimal']:.3f}"
+    assert (f"| GraspGait-v0, circle, mu 0.7, contact hand | 2 | "
+            f"{res['success_rate']:.1%} | {res['success_rate_solvable']:.1%} "
+            f"({res['solvable_episodes']}) | {res['mean_regrasps']:.2f} |") in text
+    assert ratio in text and res["command"] in text.split("## Measured results")[1]
+    # the rule-based mean over fewer starts than the agent's says over how many
+    part = dict(res, rule_success_rate_solvable=0.5, mean_rule_regrasps=19.0,
+                solvable_episodes=2)
+    from graspgait_env.agents.hub_card import evaluation_section
+
+    assert "| 19.00 (1 start) |" in "\n".join(evaluation_section([part]))
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps(dict(res, model={"path": "hexagon"})), encoding="utf-8")
+    assert main(["card", "circle", "--evaluation", str(other)]) == 2
+    assert "an evaluation of 'hexagon', not of this card's models" in capsys.readouterr().err
+    del res["command"]
+    other.write_text(json.dumps(res), encoding="utf-8")
+    assert main(["card", "circle", "--evaluation", str(other)]) == 2
+    assert "no command in it" in capsys.readouterr().err
