@@ -172,6 +172,19 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
             }],
         }],
     }
+    if benchmarks:  # the recipe's own row's tasks, each metric mean +/- std over its seeds
+        own, _ = _own_row(benchmarks)
+        for st in task_stats(own):
+            if not st["runs"]:
+                continue
+            k = st["runs"]
+            front["model-index"][0]["results"].append({
+                "task": {"type": "reinforcement-learning", "name": "reinforcement-learning"},
+                "dataset": {"name": f"graspgait benchmark v{own.get('suite_version')} "
+                                    f"{st['task']}", "type": st["task"]},
+                "metrics": [{"type": key, "name": f"{label}, {k} seeds",
+                             "value": _pm(st[key], scale, fmt), "verified": False}
+                            for key, label, scale, fmt in _TASK_METRICS]})
     seed_text = ",".join(str(s) for s in seeds if s is not None)
     lines = ["---", yaml.safe_dump(front, sort_keys=False).rstrip(), "---", "",
              f"# {title or f'`{recipe}`: {algo} on {env_id}'}", "",
@@ -352,6 +365,24 @@ def compare_rows(ours: Mapping[str, Any], other: Mapping[str, Any]) -> tuple[str
     return verdict, a - float(b["iqm"])
 
 
+#: (key of :func:`task_stats`, name in the card, scale, format) of each per-task metric.
+_TASK_METRICS = (("success", "success over starts with a gait (%)", 100.0, ".1f"),
+                 ("ratio", "regrasps / optimum", 1.0, ".3f"),
+                 ("score", "benchmark score (%)", 100.0, ".1f"))
+
+
+def _own_row(results: Sequence[Mapping[str, Any]]) -> tuple[Mapping[str, Any], str]:
+    """The row that stands for the recipe among its benchmark rows, and how the card
+    names it: the retrained one, else the shipped run, else the first."""
+    kind = [str((r.get("spec") or {}).get("kind", "")) for r in results]
+    for kinds, which in ((_RETRAINED_KINDS, "retrained over the seeds"),
+                         (_SHIPPED_KINDS, "the shipped run")):
+        for r, k in zip(results, kind, strict=True):
+            if k in kinds:
+                return r, which
+    return results[0], f"`{results[0].get('policy')}`"
+
+
 def _pm(stat: tuple[float, float] | None, scale: float, fmt: str) -> str:
     return "-" if stat is None else f"{stat[0] * scale:{fmt}} +/- {stat[1] * scale:{fmt}}"
 
@@ -433,9 +464,7 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
         lines += ["", f"Retrained over the seeds, the recipe is {verdict}: IQM "
                   f"{100.0 * b:.1f} against {100.0 * a:.1f} "
                   f"({100.0 * (b - a):+.1f} points)."]
-    ours = (retrained or shipped or list(results))[0]
-    which = ("retrained over the seeds" if retrained else "the shipped run" if shipped
-             else f"`{ours.get('policy')}`")
+    ours, which = _own_row(results)
     for name, other in against:
         verdict, diff = compare_rows(ours, other)
         lo, hi = other["aggregate"]["overall"]["iqm_ci"]

@@ -221,3 +221,17 @@ def test_evaluations_are_rows_with_the_commands_that_made_them(tmp_path, capsys)
     other.write_text(json.dumps(res), encoding="utf-8")
     assert main(["card", "circle", "--evaluation", str(other)]) == 2
     assert "no command in it" in capsys.readouterr().err
+
+
+def test_front_matter_gives_the_recipes_benchmark_tasks_over_its_seeds():
+    shipped, retrained = _row("agent", 0.99), _row("config", 0.95)
+    retrained["cells"] = [_cell("map-hand-circle", 0, 1.0, 0.8),
+                          _cell("map-hand-circle", 1, 0.8, 1.0)]
+    shipped["cells"] = [_cell("map-hand-circle", 0, 1.0, 1.0)]
+    front = _front(hub_card([_run(0, 1.0, 1.0, 400.0)], benchmarks=[shipped, retrained]))
+    results = front["model-index"][0]["results"]
+    assert [r["dataset"]["type"] for r in results] == ["GraspGaitRandom-v0", "map-hand-circle"]
+    # the retrained row's two seeds (by hand as in the per-task test), not the shipped run's
+    values = {m["type"]: (m["name"], m["value"]) for m in results[1]["metrics"]}
+    assert values["success"] == ("success over starts with a gait (%), 2 seeds", "90.0 +/- 10.0")
+    assert values["ratio"][1] == "1.125 +/- 0.125" and values["score"][1] == "80.0 +/- 0.0"
