@@ -996,8 +996,15 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
 def _cmd_card(args: argparse.Namespace) -> int:
     from graspgait_env.agents.hub_card import write_hub_card
 
+    command = shlex.join(
+        [PROG, "card", *args.models]
+        + [x for f in args.evaluation or [] for x in ("--evaluation", f)]
+        + [x for d in args.benchmark or [] for x in ("--benchmark", d)]
+        + [x for d in args.against or [] for x in ("--against", d)]
+        + (["--title", args.title] if args.title else [])
+        + (["--out", args.out] if args.out else []))
     text = write_hub_card(args.models, args.out, args.title, args.benchmark or (),
-                          args.against or (), args.evaluation or ())
+                          args.against or (), args.evaluation or (), command)
     if args.out is None:
         sys.stdout.write(text)
     else:

@@ -98,7 +98,8 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
              benchmarks: Sequence[Mapping[str, Any]] = (),
              benchmark_names: Sequence[str] | None = None,
              against: Sequence[tuple[str, Mapping[str, Any]]] = (),
-             evaluations: Sequence[Mapping[str, Any]] = ()) -> str:
+             evaluations: Sequence[Mapping[str, Any]] = (),
+             command: str | None = None) -> str:
     """The Markdown model card (Hugging Face front matter first) of one recipe's runs.
 
     Parameters
@@ -121,6 +122,9 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
         ``graspgait evaluate --json`` results of these models, each a row of a
         ``## Measured results`` table with the command that made it
         (:func:`evaluation_section`).
+    command
+        The ``graspgait card`` command line that writes this card, for its
+        ``## Reproduce`` section (default: the plain form over the run folders).
 
     Returns
     -------
@@ -231,7 +235,7 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     seeds_arg = seed_text if n > 1 else (seed_text or "0")
     lines.append(f"graspgait train {shlex.quote(recipe)} --seeds {seeds_arg}"
                  + (" --ray" if n > 1 else ""))
-    lines.append("graspgait card RUN_ROOT/*/model.zip --out README.md")
+    lines.append(command or "graspgait card RUN_ROOT/*/model.zip --out README.md")
     lines += ["```"]
     if against and not benchmarks:
         raise GraspGaitInputError(
@@ -502,13 +506,14 @@ def write_hub_card(models: Sequence[str | os.PathLike[str]],
                    title: str | None = None,
                    benchmarks: Sequence[str | os.PathLike[str]] = (),
                    against: Sequence[str] = (),
-                   evaluations: Sequence[str | os.PathLike[str]] = ()) -> str:
+                   evaluations: Sequence[str | os.PathLike[str]] = (),
+                   command: str | None = None) -> str:
     """:func:`hub_card` of the saved models ``models`` (zips with their JSON cards), with
     the ``graspgait benchmark`` row folders ``benchmarks`` (each with its
     ``result.json``) and the other recipes' row folders ``against``, each ``NAME=DIR`` or
     ``DIR`` (named by its folder), and the ``graspgait evaluate --json`` files
     ``evaluations`` (of these models; another model's is refused); written atomically to
-    ``out`` when given. Returns the card."""
+    ``out`` when given; ``command`` is the card's own command line. Returns the card."""
     from graspgait_env.agents.card import read_card, resolve_model
     from graspgait_env.atomic import write_text_atomic
 
@@ -548,7 +553,7 @@ def write_hub_card(models: Sequence[str | os.PathLike[str]],
         evals.append(res)
     text = hub_card([read_card(p) for p in paths], names=[str(m) for m in models],
                     title=title, benchmarks=rows, benchmark_names=[str(d) for d in benchmarks],
-                    against=others, evaluations=evals)
+                    against=others, evaluations=evals, command=command)
     if out is not None:
         write_text_atomic(Path(out), text)
     return text

@@ -235,3 +235,11 @@ def test_front_matter_gives_the_recipes_benchmark_tasks_over_its_seeds():
     values = {m["type"]: (m["name"], m["value"]) for m in results[1]["metrics"]}
     assert values["success"] == ("success over starts with a gait (%), 2 seeds", "90.0 +/- 10.0")
     assert values["ratio"][1] == "1.125 +/- 0.125" and values["score"][1] == "80.0 +/- 0.0"
+
+
+def test_the_card_names_the_command_that_wrote_it(tmp_path, capsys):
+    out = tmp_path / "card.md"
+    assert main(["card", "circle", "--title", "the circle", "--out", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert f"graspgait card circle --title 'the circle' --out {out}\n" in text
+    assert "RUN_ROOT" in hub_card([_run(0, 1.0, 1.0, 400.0)])  # from Python: the plain form

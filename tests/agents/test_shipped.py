@@ -17,6 +17,7 @@ from graspgait_env.agents.card import (
     RETIRED_AGENTS,
     describe_shipped,
     load_agent,
+    read_card,
     resolve_model,
     shipped_agents,
     shipped_models_dir,
@@ -47,6 +48,48 @@ def test_every_shipped_agent_is_installed_with_both_cards():
     described = dict(describe_shipped())
     assert sorted(described) == sorted(SHIPPED_AGENTS)
     assert "GraspGaitRandom-v0" in described["random"] and "x the optimum" in described["random"]
+
+
+@pytest.mark.parametrize("name", SHIPPED_AGENTS)
+def test_every_shipped_model_card_is_written_by_the_card_command(name):
+    """Each ``NAME.md`` is ``graspgait card``'s output: its front matter, its heading line
+    and its run table's row of the shipped model, read from ``NAME.json``, are what
+    :func:`hub_card` writes from that JSON card; a card typed or edited by hand, or left
+    behind by a retraining, fails here."""
+    from graspgait_env.agents.hub_card import hub_card
+
+    text = (shipped_models_dir() / f"{name}.md").read_text(encoding="utf-8")
+    card = read_card(shipped_models_dir() / f"{name}.zip")
+    alone = hub_card([card], names=[name])
+    assert "Written by `graspgait card` from the runs' own cards." in text
+    ev = card["eval"]
+    row = (f"| `{name}` | {card['seed']} | {card['steps']} | {float(card['wall_s']):.0f} | "
+           f"{100.0 * ev['success_rate_solvable']:.1f} | {ev['regrasps_vs_optimal']:.3f} |")
+    assert row in text and row in alone
+    assert f"- env keywords: `{json.dumps(card['env_kwargs'], sort_keys=True)}`" in text
+    if "; 1 run (seeds" in text:  # one run: the front matter's first result is this card's
+        import yaml
+
+        first = [yaml.safe_load(x.split("---\n")[1])["model-index"][0]["results"][0]
+                 for x in (text, alone)]
+        assert first[0] == first[1]
+
+
+def test_the_circle_cards_measured_row_is_a_fresh_evaluation():
+    """The circle card's first measured row, recomputed by the command it names."""
+    import shlex
+
+    from graspgait_env.agents.hub_card import evaluation_section
+
+    text = (shipped_models_dir() / "circle.md").read_text(encoding="utf-8")
+    block = text.split("## Measured results")[1].split("```bash\n")[1].split("```")[0]
+    command = block.splitlines()[0]
+    assert command == "graspgait evaluate circle --episodes 100"
+    argv = shlex.split(command)
+    result = evaluate("circle", episodes=int(argv[argv.index("--episodes") + 1]),
+                      progress=False)
+    result["command"] = command
+    assert evaluation_section([result])[5] in text
 
 
 def test_shipped_names_resolve_and_unknown_names_list_what_exists(tmp_path, monkeypatch):
