@@ -190,11 +190,12 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
                              "value": _pm(st[key], scale, fmt), "verified": False}
                             for key, label, scale, fmt in _TASK_METRICS]})
     seed_text = ",".join(str(s) for s in seeds if s is not None)
+    plural = "s" if n != 1 else ""
     lines = ["---", yaml.safe_dump(front, sort_keys=False).rstrip(), "---", "",
              f"# {title or f'`{recipe}`: {algo} on {env_id}'}", "",
              f"{algo} ({'sb3-contrib' if algo == 'maskable_ppo' else 'stable-baselines3'}) "
              f"trained on `{env_id}` with the recipe `{recipe}`; {n} "
-             f"run{'s' if n != 1 else ''} (seeds {seed_text or 'unknown'}). Written by "
+             f"run{plural} (seed{plural} {seed_text or 'unknown'}). Written by "
              "`graspgait card` from the runs' own cards.", "",
              "## Environment", "",
              f"- env id: `{env_id}`",

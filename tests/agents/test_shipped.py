@@ -67,7 +67,7 @@ def test_every_shipped_model_card_is_written_by_the_card_command(name):
            f"{100.0 * ev['success_rate_solvable']:.1f} | {ev['regrasps_vs_optimal']:.3f} |")
     assert row in text and row in alone
     assert f"- env keywords: `{json.dumps(card['env_kwargs'], sort_keys=True)}`" in text
-    if "; 1 run (seeds" in text:  # one run: the front matter's first result is this card's
+    if "; 1 run (seed " in text:  # one run: the front matter's first result is this card's
         import yaml
 
         first = [yaml.safe_load(x.split("---\n")[1])["model-index"][0]["results"][0]
