@@ -138,6 +138,10 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
     """
     if not cards:
         raise GraspGaitInputError("MODEL: give at least one model (one per seed)")
+    if against and not benchmarks:
+        raise GraspGaitInputError(
+            "--against: give this recipe's own rows too (--benchmark DIR: the shipped run's "
+            "row agent:NAME, the retrained recipe's config:NAME); the comparison is theirs")
     names = list(names) if names is not None else [f"run {i + 1}" for i in range(len(cards))]
     _check_same(cards, names)
     for card, name in zip(cards, names, strict=True):
@@ -238,10 +242,6 @@ def hub_card(cards: Sequence[Mapping[str, Any]], *, names: Sequence[str] | None 
                  + (" --ray" if n > 1 else ""))
     lines.append(command or "graspgait card RUN_ROOT/*/model.zip --out README.md")
     lines += ["```"]
-    if against and not benchmarks:
-        raise GraspGaitInputError(
-            "--against: give this recipe's own rows too (--benchmark DIR: the shipped run's "
-            "row agent:NAME, the retrained recipe's config:NAME); the comparison is theirs")
     if benchmarks:
         lines += benchmark_section(benchmarks, benchmark_names, against)
     lines += ["", "## Use", "", "```bash",
@@ -417,30 +417,28 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
         seeds.
     """
     names = list(names) if names is not None else [f"row {i + 1}" for i in range(len(results))]
-    rows = [*zip(names, results, strict=True),
+    rows = [*((f"--benchmark {n}", r) for n, r in zip(names, results, strict=True)),
             *((f"--against {n}", r) for n, r in against)]
-    for name, res in rows:
+    for flag, res in rows:
         if not isinstance(res.get("aggregate"), Mapping) or "overall" not in res["aggregate"]:
-            what = name if name.startswith("--against") else f"--benchmark {name}"
             raise GraspGaitInputError(
-                f"{what}: no suite aggregate in its result.json; give the folder "
+                f"{flag}: no suite aggregate in its result.json; give the folder "
                 "of a finished `graspgait benchmark` row (its --out)")
     first = results[0]
-    for name, res in rows[1:]:
+    for flag, res in rows[1:]:
         for key in ("suite_version", "tasks", "seeds"):
             if res.get(key) != first.get(key):
-                what = name if name.startswith("--against") else f"--benchmark {name}"
                 raise GraspGaitInputError(
-                    f"{what}: its {key} {res.get(key)!r} differs from "
+                    f"{flag}: its {key} {res.get(key)!r} differs from "
                     f"{names[0]}'s {first.get(key)!r}; rows compared in a card share the "
                     "suite, the tasks and the seeds")
-    every = [*results, *(r for _, r in against)]
+    every = [r for _, r in rows]
     tracks = list(dict.fromkeys(t for r in every for t in r["aggregate"].get("tracks", {})))
     seeds = ",".join(str(s) for s in first.get("seeds") or [])
-    kinds = {"agent": " (the shipped run)", "agent-template": " (retrained per seed)",
-             "config": " (retrained per seed)"}
-    labels = [f"`{r.get('policy')}`"
-              + kinds.get(str((r.get("spec") or {}).get("kind")), "") for r in results]
+    kind = [str((r.get("spec") or {}).get("kind", "")) for r in results]
+    labels = [f"`{r.get('policy')}`" + (" (the shipped run)" if k in _SHIPPED_KINDS else
+                                        " (retrained per seed)" if k in _RETRAINED_KINDS else "")
+              for r, k in zip(results, kind, strict=True)]
     labels += [f"`{n}` (against)" for n, _ in against]
     lines = ["", f"## Benchmark (suite v{first.get('suite_version')}, seeds {seeds})", "",
              "Score in percent (success x efficiency) over the benchmark's test starts; "
@@ -458,7 +456,6 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
                      f"{_ci(agg['overall'], 'iqm')} | {_ci(agg['overall'], 'mean')} | "
                      + " | ".join(per) + f" | {'' if wall is None else f'{float(wall):.0f}'}"
                      f" | {res.get('date', '')} | `{res.get('command', '')}` |")
-    kind = [str((r.get("spec") or {}).get("kind", "")) for r in results]
     shipped = [r for r, k in zip(results, kind, strict=True) if k in _SHIPPED_KINDS]
     retrained = [r for r, k in zip(results, kind, strict=True) if k in _RETRAINED_KINDS]
     if len(shipped) == 1 and len(retrained) == 1:
@@ -483,8 +480,8 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
                   f"{100.0 * ours['aggregate']['overall']['iqm']:.1f} against "
                   f"{100.0 * other['aggregate']['overall']['iqm']:.1f} "
                   f"({100.0 * diff:+.1f} points), {how}."]
-    per_task = [(label, task_stats(r)) for label, r in zip(labels, every, strict=True)
-                if r.get("cells")]
+    per_task = [(label, {x["task"]: x for x in task_stats(r)})
+                for label, r in zip(labels, every, strict=True) if r.get("cells")]
     if per_task:
         lines += ["", "Per task, mean +/- std over the seeds (success over the starts with a "
                   "gait; regrasps over the optimum's on the successes; score):", "",
@@ -492,7 +489,7 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
                   "|---|---|---:|---|---|---|"]
         for task in first.get("tasks") or []:
             for label, stats in per_task:
-                st = next((x for x in stats if x["task"] == task), None)
+                st = stats.get(task)
                 if st is None or not st["runs"]:
                     continue
                 lines.append(f"| {task} | {label} | {st['runs']} | "
