@@ -111,7 +111,7 @@ def parse_policy(text: str) -> PolicySpec:
         if not depth.isdigit() or not 1 <= int(depth) <= MAX_REACH_DEPTH + 1:
             raise GraspGaitInputError(
                 f"POLICY {text!r}: the look-ahead depth D of greedy-reach:D is 1 to "
-                f"{MAX_REACH_DEPTH + 1} regrasps, e.g. greedy-reach:5")
+                f"{MAX_REACH_DEPTH + 1} regrasps, e.g. greedy-reach:8")
         if int(depth) == GREEDY_REACH_DEPTH:  # the default row, as before
             return PolicySpec("greedy-reach", "", "greedy-reach")
         return PolicySpec("greedy-reach", str(int(depth)), f"greedy-reach-{int(depth)}")

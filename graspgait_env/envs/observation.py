@@ -130,20 +130,20 @@ def greedy_ranks(reach: NDArray[np.floating], finishing: NDArray[np.bool_],
     B, A, D = reach.shape
     R2 = int(np.size(rot_delta))
     illegal = ~np.asarray(legal, dtype=bool)
-    base = int(none) + 1
     s = np.rint(np.asarray(reach, dtype=np.float64) * turn_steps).astype(np.int64)
-    key = (~np.asarray(finishing, dtype=bool)).astype(np.int64)
-    for j in range(D - 1, -1, -1):  # the deepest first
-        key = key * base + s[:, :, j].clip(0, none)
     size = np.zeros(A, dtype=np.int64)
     size[:R2] = np.abs(rot_delta)
-    key = key * (int(size.max()) + 1) + size
     tie = np.empty(A, dtype=np.int64)  # the regrasps, then the rotations
     tie[np.concatenate((np.arange(R2, A), np.arange(R2)))] = np.arange(A)
-    key = key * A + tie
-    key[illegal] = np.iinfo(np.int64).max
+    # np.lexsort sorts by its last key first: illegal moves last, then a finishing
+    # rotation first, the deepest shortfall, ..., the shallowest, the size, the tie
+    # (a lexicographic sort, not one packed integer key, which overflows int64 deeper
+    # than 6 regrasps)
+    keys = [np.broadcast_to(tie, (B, A)), np.broadcast_to(size, (B, A))]
+    keys += [s[:, :, j].clip(0, int(none)) for j in range(D)]
+    keys += [~np.asarray(finishing, dtype=bool), illegal]
     ranks = np.empty((B, A), dtype=np.int64)
-    np.put_along_axis(ranks, np.argsort(key, axis=1), np.arange(A)[None, :], axis=1)
+    np.put_along_axis(ranks, np.lexsort(keys, axis=-1), np.arange(A)[None, :], axis=1)
     ranks[illegal] = A
     return ranks
 

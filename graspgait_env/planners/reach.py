@@ -23,7 +23,8 @@ regrasp deep) cannot see. The GraspGait envs offer it as an opt-in observation f
 (``regrasp_lookahead``). It is not the optimum: at depth ``J`` it tells whether the turn
 is reached within ``J`` more regrasps and, when not, how close the best such chain gets;
 the exact planner's count to go is the smallest ``j`` with a shortfall of 0, which for
-the procedural objects is about 9 regrasps from the start, beyond the depths offered.
+the procedural objects is about 9 regrasps from the start (up to 21 on the held-out
+ones), mostly beyond the depths offered.
 
 Search window: the exact planner's :class:`~graspgait_env.planners.exact.RegraspsToGo`
 window (object angles from ``max_backward_deg`` against the turn to the turn), so a
@@ -41,8 +42,14 @@ from graspgait_env.planners.exact import PAIRS, _pair_index, _to_go_window
 
 __all__ = ["MAX_REACH_DEPTH", "RegraspReach"]
 
-MAX_REACH_DEPTH = 4
-"""The deepest reach table :class:`RegraspReach` builds (regrasps)."""
+MAX_REACH_DEPTH = 9
+"""The deepest reach table :class:`RegraspReach` builds (regrasps); the envs'
+``regrasp_lookahead`` goes one deeper, to 10. Each level is one ``(3, L, L)`` int64 table
+(``L`` the longest finger's contact range) and adds a propagation per gait model; the
+orders read from the tables are lexicographic sorts, so no depth overflows a packed key.
+Measured on held-out procedural objects (hand contact, 300 resets from seed 20000, the
+benchmark's greedy reading): 96.6% of the 146 starts with a gait at 5 regrasps deep,
+97.9% at 6, 100% at 8 (1.007x the optimum's regrasps) and at 10 (1.004x)."""
 
 
 def _range_max(values: NDArray[np.int64], lo: NDArray[np.int64],
@@ -253,8 +260,11 @@ class RegraspReach:
         regrasp[~legal] = none
         # after each rotation, the regrasp that is best first at depth D - 1, then D - 2, ...
         cand = best[:, :, :, 1:, :].transpose(2, 3, 0, 4, 1).reshape(N, R2, 2 * P, D)
-        key = (cand * (none + 1) ** np.arange(D)).sum(axis=3)
-        rot = np.take_along_axis(cand, key.argmin(axis=2)[:, :, None, None], axis=2)[:, :, 0]
+        # lexicographic, the deepest first (np.lexsort's last key); ties: the first
+        # candidate (the lower lift, then the lower position)
+        order = np.lexsort([np.broadcast_to(np.arange(2 * P), cand.shape[:3])]
+                           + [cand[..., j] for j in range(D)], axis=-1)
+        rot = np.take_along_axis(cand, order[:, :, :1, None], axis=2)[:, :, 0]
         rot[sign * ks[:, 1:] >= K] = 0  # the rotation itself reaches the turn
         rot[~mask[:, :R2]] = none
         out = np.empty((N, (2 * P + R2) * D), dtype=np.float32)

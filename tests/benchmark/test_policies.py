@@ -24,8 +24,8 @@ def test_policy_names_resolve():
     assert parse_policy("greedy-reach").kind == "greedy-reach"
     assert parse_policy("greedy-reach:3") == parse_policy("greedy-reach")
     assert parse_policy("greedy-reach:5").label == "greedy-reach-5"
-    for bad in ("greedy-reach:0", "greedy-reach:6", "greedy-reach:x"):
-        with pytest.raises(GraspGaitInputError, match="depth D of greedy-reach:D is 1 to 5"):
+    for bad in ("greedy-reach:0", "greedy-reach:11", "greedy-reach:x"):
+        with pytest.raises(GraspGaitInputError, match="depth D of greedy-reach:D is 1 to 10"):
             parse_policy(bad)
     assert parse_policy("agent:random").kind == "agent"  # the shipped agent, not the policy
     hexagon = parse_policy("hexagon")

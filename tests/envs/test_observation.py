@@ -193,6 +193,9 @@ def _greedy_by_tuples(act, lay, model, K):
 @pytest.mark.parametrize("kw", [
     {"object": "ellipse", "regrasp_lookahead": 3, "contact_model": "hand"},
     {"object": "pentagon", "regrasp_lookahead": 2, "turn_deg": -90.0, "mu": 0.5},
+    # deeper than 6 regrasps a key packed into one int64 overflowed (the general
+    # recipe reads 8): the order must still be the tuples' order
+    {"object": "hexagon", "regrasp_lookahead": 8, "contact_model": "hand"},
 ])
 def test_reach_rank_is_the_greedy_reading(kw):
     """``reach_rank`` orders the legal moves as the greedy reading does, written here

@@ -39,7 +39,9 @@ def brute_force_reach(env, D: int) -> np.ndarray:
 
 @pytest.mark.parametrize("kw, D", [({"object": "ellipse"}, 2),
                                    ({"object": "pentagon", "n": 90, "turn_deg": -360.0}, 3),
-                                   ({"object": "hexagon", "forbid_revisit": True}, 1)])
+                                   ({"object": "hexagon", "forbid_revisit": True}, 1),
+                                   # the deepest table: rotations' picks by tuples
+                                   ({"object": "ellipse", "contact_model": "hand"}, 10)])
 def test_field_is_the_reach_of_every_move(kw, D):
     env = gym.make("graspgait_env:GraspGait-v0", mu=0.7, regrasp_lookahead=D, **kw)
     plain = gym.make("graspgait_env:GraspGait-v0", mu=0.7, **kw)
@@ -117,7 +119,9 @@ def test_off_by_default_and_checked():
     env = gym.make("graspgait_env:GraspGait-v0")
     assert env.unwrapped.layout.reach.stop - env.unwrapped.layout.reach.start == 0
     assert env.unwrapped.config.regrasp_lookahead == 0
-    for bad in (-1, 6, 1.5, True, "2"):
+    from graspgait_env.planners.reach import MAX_REACH_DEPTH
+
+    for bad in (-1, MAX_REACH_DEPTH + 2, 1.5, True, "2"):
         with pytest.raises(GraspGaitInputError, match="regrasp_lookahead="):
             gym.make("graspgait_env:GraspGait-v0", regrasp_lookahead=bad)
 
