@@ -358,6 +358,13 @@ def task_stats(result: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
+def _points(diff: float) -> str:
+    """A difference of two scores in [0, 1] as signed percentage points, one decimal
+    (``+0.0`` for a difference that rounds to zero, never ``-0.0``)."""
+    v = 100.0 * float(diff)
+    return f"{0.0 if abs(v) < 0.05 else v:+.1f} points"
+
+
 def compare_rows(ours: Mapping[str, Any], other: Mapping[str, Any]) -> tuple[str, float]:
     """How the suite IQM of row ``ours`` stands against row ``other``'s 95% interval:
     ``("better", d)`` above its upper end, ``("worse", d)`` below its lower end, else
@@ -465,7 +472,7 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
                    "as good as its shipped run or better")
         lines += ["", f"Retrained over the seeds, the recipe is {verdict}: IQM "
                   f"{100.0 * b:.1f} against {100.0 * a:.1f} "
-                  f"({100.0 * (b - a):+.1f} points)."]
+                  f"({_points(b - a)})."]
     ours, which = _own_row(results)
     for name, other in against:
         verdict, diff = compare_rows(ours, other)
@@ -479,7 +486,7 @@ def benchmark_section(results: Sequence[Mapping[str, Any]],
                   f"({which}) is **{verdict}**: IQM "
                   f"{100.0 * ours['aggregate']['overall']['iqm']:.1f} against "
                   f"{100.0 * other['aggregate']['overall']['iqm']:.1f} "
-                  f"({100.0 * diff:+.1f} points), {how}."]
+                  f"({_points(diff)}), {how}."]
     per_task = [(label, {x["task"]: x for x in task_stats(r)})
                 for label, r in zip(labels, every, strict=True) if r.get("cells")]
     if per_task:

@@ -243,3 +243,13 @@ def test_the_card_names_the_command_that_wrote_it(tmp_path, capsys):
     text = out.read_text(encoding="utf-8")
     assert f"graspgait card circle --title 'the circle' --out {out}\n" in text
     assert "RUN_ROOT" in hub_card([_run(0, 1.0, 1.0, 400.0)])  # from Python: the plain form
+
+
+def test_a_difference_that_rounds_to_zero_reads_plus_zero_points():
+    """Two IQMs 0.0004 apart (e.g. 1.0 against 0.9996): ``+0.0 points``, not ``-0.0``."""
+    from graspgait_env.agents.hub_card import _points
+
+    assert _points(-0.0004) == "+0.0 points"
+    assert _points(0.0) == "+0.0 points"
+    assert _points(-0.001) == "-0.1 points"
+    assert _points(0.026) == "+2.6 points"
