@@ -79,6 +79,11 @@ class Imitation:
     teacher: str = "optimal"
     """``optimal`` (the optimum's set) or ``greedy`` (the greedy reading's move, corrected
     by the optimum where it wastes a regrasp; module docstring)."""
+    correction_weight: float = 1.0
+    """With ``teacher: greedy``, the weight in the loss of a *correction*: a state whose
+    label is the optimum's set because the greedy reading's move wastes a regrasp (>= 1;
+    the other states weigh 1). Corrections are rare, so at weight 1 the policy learns
+    the greedy reading and few of its corrections."""
 
     def __post_init__(self) -> None:
         for name, example in (("iterations", 10), ("labels", 4000), ("epochs", 8),
@@ -91,6 +96,12 @@ class Imitation:
             raise GraspGaitInputError(
                 f"imitation.teacher={self.teacher!r}: use 'optimal' (the optimum's set) or "
                 "'greedy' (the greedy reading's move, corrected by the optimum)")
+        object.__setattr__(self, "correction_weight", check_number(
+            "imitation.correction_weight", self.correction_weight, 10.0, minimum=1.0))
+        if self.teacher != "greedy" and self.correction_weight != 1.0:
+            raise GraspGaitInputError(
+                f"imitation.correction_weight={self.correction_weight!r}: weighs the "
+                "greedy teacher's corrections; set teacher: greedy or leave it at 1.0")
 
     @classmethod
     def from_mapping(cls, value: Any) -> Imitation:
@@ -113,16 +124,21 @@ class Imitation:
         return asdict(self)
 
 
-def set_loss(log_probs: Any, in_set: Any) -> Any:
+def set_loss(log_probs: Any, in_set: Any, weights: Any = None) -> Any:
     """Minus the log of the probability a policy gives a set of actions, averaged.
 
     ``log_probs``: ``(batch, actions)`` log-probabilities (masked actions at a very
     negative value); ``in_set``: ``(batch, actions)`` bools, each row with at least one
-    True. ``mean_i -log sum_{a in set_i} p_i(a)``: 0 when all the mass is inside the set.
+    True; ``weights``: ``(batch,)`` row weights, or None for all 1.
+    ``sum_i w_i (-log sum_{a in set_i} p_i(a)) / sum_i w_i``: 0 when all the mass is
+    inside the set.
     """
     import torch
 
-    return -torch.logsumexp(log_probs.masked_fill(~in_set, -1e9), dim=1).mean()
+    nll = -torch.logsumexp(log_probs.masked_fill(~in_set, -1e9), dim=1)
+    if weights is None:
+        return nll.mean()
+    return (nll * weights).sum() / weights.sum()
 
 
 def greedy_labels(rank: np.ndarray, masks: np.ndarray, optimal: np.ndarray,
@@ -192,7 +208,8 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
     Returns
     -------
     dict
-        ``iterations``, ``labels`` (states trained on), ``env_steps``, ``loss`` (the
+        ``iterations``, ``labels`` (states trained on), ``corrections`` (of them, the
+        greedy teacher's corrections), ``env_steps``, ``loss`` (the
         last iteration's mean), ``losses`` (per iteration), ``wall_s``, ``config``.
     """
     import torch
@@ -209,8 +226,9 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
     obs_parts: list[Any] = []
     mask_parts: list[np.ndarray] = []
     set_parts: list[np.ndarray] = []
+    weight_parts: list[np.ndarray] = []
     losses: list[float] = []
-    env_steps = 0
+    env_steps = corrections = 0
     total = config.iterations * config.labels
     bar = tqdm(total=total, desc="imitation", unit="label", disable=not progress)
     obs = venv.reset()
@@ -222,14 +240,20 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
             while got < config.labels:
                 masks = np.stack(venv.env_method("action_masks"))
                 teach = np.stack(venv.env_method("optimal_moves"))
+                weight = np.ones(len(masks))
                 if config.teacher == "greedy":
-                    teach = greedy_labels(np.asarray(obs["actions"])[:, :, rank_col], masks,
-                                          teach, rotations)
+                    rank = np.asarray(obs["actions"])[:, :, rank_col]
+                    teach = greedy_labels(rank, masks, teach, rotations)
+                    greedy = np.where(masks, rank, np.inf).argmin(axis=1)
+                    fixed = teach.any(axis=1) & ~teach[np.arange(len(masks)), greedy]
+                    weight[fixed] = config.correction_weight
+                    corrections += int(fixed.sum())
                 keep = teach.any(axis=1)
                 if keep.any():
                     obs_parts.append(_obs_rows(obs, keep))
                     mask_parts.append(masks[keep])
                     set_parts.append(teach[keep])
+                    weight_parts.append(weight[keep])
                     got += int(keep.sum())
                     bar.update(int(keep.sum()))
                 if it == 0:  # the teacher's moves (a legal one where it has none)
@@ -240,25 +264,28 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
                 obs, _, _, _ = venv.step(actions)
                 env_steps += venv.num_envs
             losses.append(_fit(policy, opt, _concat(obs_parts), np.concatenate(mask_parts),
-                               np.concatenate(set_parts), config, rng))
+                               np.concatenate(set_parts), np.concatenate(weight_parts),
+                               config, rng))
             bar.set_postfix(loss=f"{losses[-1]:.3f}")
     finally:
         bar.close()
     return {"iterations": config.iterations, "labels": int(sum(len(m) for m in mask_parts)),
-            "env_steps": env_steps, "loss": losses[-1], "losses": losses,
+            "corrections": corrections, "env_steps": env_steps, "loss": losses[-1],
+            "losses": losses,
             "wall_s": time.perf_counter() - t0, "config": config.to_dict()}
 
 
 def _fit(policy: Any, opt: Any, obs: Any, masks: np.ndarray, sets: np.ndarray,
-         config: Imitation, rng: np.random.Generator) -> float:
-    """``config.epochs`` passes of :func:`set_loss` over the aggregate; the mean loss of
-    the last pass."""
+         weights: np.ndarray, config: Imitation, rng: np.random.Generator) -> float:
+    """``config.epochs`` passes of :func:`set_loss` (rows weighted by ``weights``) over
+    the aggregate; the mean loss of the last pass."""
     import torch
 
     n = len(masks)
     obs_t = ({k: torch.as_tensor(v) for k, v in obs.items()} if isinstance(obs, dict)
              else torch.as_tensor(obs))
     sets_t = torch.as_tensor(sets)
+    weights_t = torch.as_tensor(weights, dtype=torch.float32)
     policy.set_training_mode(True)
     last: list[float] = []
     try:
@@ -271,7 +298,7 @@ def _fit(policy: Any, opt: Any, obs: Any, masks: np.ndarray, sets: np.ndarray,
                 o = ({k: v[bt] for k, v in obs_t.items()} if isinstance(obs_t, dict)
                      else obs_t[bt])
                 dist = policy.get_distribution(o, action_masks=masks[b])
-                loss = set_loss(dist.distribution.logits, sets_t[bt])
+                loss = set_loss(dist.distribution.logits, sets_t[bt], weights_t[bt])
                 opt.zero_grad()
                 loss.backward()
                 torch.nn.utils.clip_grad_norm_(policy.parameters(), 1.0)

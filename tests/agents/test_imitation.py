@@ -25,6 +25,13 @@ def test_set_loss_is_minus_the_log_of_the_set_probability() -> None:
     # by hand: -(log 0.5 + log 0.5) / 2
     assert math.isclose(float(set_loss(logp, in_set)), -math.log(0.5), rel_tol=1e-6)
     assert float(set_loss(logp, torch.tensor([[True] * 4] * 2))) == pytest.approx(0.0, abs=1e-6)
+    # weighted rows (the greedy teacher's corrections): set probabilities 0.5 and 0.4,
+    # weights 1 and 3 -> (-log 0.5 - 3 log 0.4) / 4
+    only_last = torch.tensor([[False, True, True, False], [False, False, False, True]])
+    got = float(set_loss(logp, only_last, torch.tensor([1.0, 3.0])))
+    assert math.isclose(got, -(math.log(0.5) + 3 * math.log(0.4)) / 4, rel_tol=1e-6)
+    assert float(set_loss(logp, only_last, torch.ones(2))) == pytest.approx(
+        float(set_loss(logp, only_last)))
 
 
 def test_the_block_is_checked_and_round_trips() -> None:
@@ -36,6 +43,12 @@ def test_the_block_is_checked_and_round_trips() -> None:
     with pytest.raises(GraspGaitInputError, match=r"imitation with algo='ppo'"):
         load_train_config("general", ["algo=ppo", "policy=MlpPolicy",
                                       "features_extractor=null"])
+    with pytest.raises(GraspGaitInputError, match=r"imitation\.correction_weight=0\.5"):
+        Imitation(teacher="greedy", correction_weight=0.5)
+    with pytest.raises(GraspGaitInputError, match=r"correction_weight=3\.0: weighs the "
+                       "greedy teacher's corrections; set teacher: greedy"):
+        Imitation(teacher="optimal", correction_weight=3.0)
+    assert Imitation(teacher="greedy", correction_weight=30).correction_weight == 30.0
     cfg = load_train_config("general")
     assert cfg.imitation == Imitation(iterations=10, labels=4000, epochs=8, batch_size=256,
                                      teacher="greedy")
