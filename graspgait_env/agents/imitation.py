@@ -153,12 +153,18 @@ def greedy_labels(rank: np.ndarray, masks: np.ndarray, optimal: np.ndarray,
     label).
     """
     rows = np.arange(len(rank))
-    greedy = np.where(masks, rank, np.inf).argmin(axis=1)
+    greedy = _greedy_moves(rank, masks)
     keep = optimal.any(axis=1) & (optimal[rows, greedy] | (greedy < int(rotations)))
     out = optimal.copy()
     out[keep] = False
     out[rows[keep], greedy[keep]] = True
     return out
+
+
+def _greedy_moves(rank: np.ndarray, masks: np.ndarray) -> np.ndarray:
+    """``(B,)`` the move each state's greedy reading plays: its least ``reach_rank``
+    among the legal moves."""
+    return np.where(masks, rank, np.inf).argmin(axis=1)
 
 
 def _rank_column(obs: Any, venv: Any) -> tuple[int, int]:
@@ -244,7 +250,7 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
                 if config.teacher == "greedy":
                     rank = np.asarray(obs["actions"])[:, :, rank_col]
                     teach = greedy_labels(rank, masks, teach, rotations)
-                    greedy = np.where(masks, rank, np.inf).argmin(axis=1)
+                    greedy = _greedy_moves(rank, masks)
                     fixed = teach.any(axis=1) & ~teach[np.arange(len(masks)), greedy]
                     weight[fixed] = config.correction_weight
                     corrections += int(fixed.sum())
@@ -271,8 +277,7 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
         bar.close()
     return {"iterations": config.iterations, "labels": int(sum(len(m) for m in mask_parts)),
             "corrections": corrections, "env_steps": env_steps, "loss": losses[-1],
-            "losses": losses,
-            "wall_s": time.perf_counter() - t0, "config": config.to_dict()}
+            "losses": losses, "wall_s": time.perf_counter() - t0, "config": config.to_dict()}
 
 
 def _fit(policy: Any, opt: Any, obs: Any, masks: np.ndarray, sets: np.ndarray,
