@@ -911,11 +911,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                        "extra.",
                        epilog=_epilog(["evaluate --list",
                                        "evaluate general --object ellipse --episodes 20",
-                                       "evaluate random --object my_shape.yaml --mu 0.5",
+                                       "evaluate general --object my_shape.yaml --mu 0.5",
                                        "evaluate runs/RUN/model.zip --json eval.json",
                                        "evaluate hexagon --env GraspGaitMujoco-v1 --episodes 5"],
-                                      duration="5-60 s for 100 episodes at map level (the "
-                                      "look-ahead of random plays them one by one); about "
+                                      duration="5-60 s for 100 episodes at map level; about "
                                       "2 s per episode on the MuJoCo hand"))
     p.add_argument("model", metavar="MODEL", nargs="?",
                    help="a shipped agent's name (see --list) or a model zip saved by "
@@ -978,7 +977,7 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
                        "simulate OUT/OBJECT_learned_plan.json --video F.mp4`). Exit 1 when the "
                        "agent does not reach the turn. Needs the [train] extra.",
                        epilog=_epilog(["story", "story hexagon --out story",
-                                       "story random --object my_shape.yaml --mu 0.6",
+                                       "story general --object my_shape.yaml --mu 0.6",
                                        "story general --object ellipse --start 50,270"],
                                       duration="5-20 s"))
     p.add_argument("model", metavar="MODEL", nargs="?", default="general",
@@ -1207,7 +1206,7 @@ def _add_benchmark(sub: argparse._SubParsersAction) -> None:
                                        "--seeds 0-1 --episodes 3",
                                        "benchmark rule --tasks map-point,random",
                                        "benchmark greedy-reach --json row.json --md row.md",
-                                       "benchmark agent:random --tasks random --ray",
+                                       "benchmark agent:general --tasks random --ray",
                                        "benchmark config:ellipse --tasks map-hand-ellipse",
                                        "benchmark --scoreboard benchmark/rule benchmark/random "
                                        "--md board.md --png board.png"],

@@ -21,7 +21,7 @@ from the same start under the same contact model (``contact_model``,
 ratios of :func:`agent_rows` use those.
 
 Which agent runs where: an agent trained on ``GraspGaitRandom-v0`` (a generalist, e.g.
-``random.zip``) runs on every object; an agent trained on one object runs on that
+``general.zip``) runs on every object; an agent trained on one object runs on that
 object only (at every ``mu`` of the bench).
 
 :func:`agents_markdown` adds the comparison table: per object and ``mu``, each agent's
@@ -58,10 +58,10 @@ from graspgait_env.gait import GaitModel
 __all__ = ["SHIPPED_AGENTS", "Agent", "agents_markdown", "find_agents", "plot_bench",
            "run_agent_bench", "shipped_models_dir"]
 
-SHIPPED_AGENTS = ("general", "circle", "hexagon", "random")
+SHIPPED_AGENTS = ("general", "circle", "hexagon")
 """The agents the project ships (``models/NAME.zip`` of :mod:`graspgait_env.agents`, with
-their cards); a test fails when one is missing from the install. The ellipse's and the
-pentagon's are retired (:data:`graspgait_env.agents.card.RETIRED_AGENTS`)."""
+their cards); a test fails when one is missing from the install. The ellipse's, the
+pentagon's and ``random`` are retired (:data:`graspgait_env.agents.card.RETIRED_AGENTS`)."""
 
 
 @dataclass

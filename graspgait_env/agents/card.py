@@ -54,12 +54,21 @@ RETIRED_AGENTS: dict[str, str] = {
     "pentagon": "retired after graspgait_env 0.2.0: over 5 seeds on the pentagon's three "
                 "benchmark tasks the shipped agent general scores as well (IQM 100.0 [100.0, "
                 "100.0] against the pentagon recipe's 100.0 [99.4, 100.0])",
+    "random": "retired after graspgait_env 0.2.0: on the benchmark's held-out procedural "
+              "objects (random-l1, 5 seeds) both its shipped run and its recipe score below "
+              "the shipped agent general (IQM 97.8 [95.8, 98.3] and 97.4 [96.2, 98.0] "
+              "against 99.8 [99.5, 100.0])",
 }
 """Shipped agents that are no longer shipped, by name: why (one clause). A per-object
 agent stays shipped only where it is measurably better than ``general`` on its object over
 5 seeds (docs/agents.md); asking for a retired one by name raises an error that says so
-and names the replacement, ``general`` on the same object. Its training config stays
-bundled (``graspgait train ellipse`` still trains the recipe)."""
+and names the replacement (:func:`retired_message`): ``general`` on the same object, or
+for ``random``, the generalist trained on the same procedural objects, ``general`` on
+them. Its training config stays bundled (``graspgait train ellipse`` still trains the
+recipe)."""
+
+_HELD_OUT = ("--set 'object_seeds=[1000000,1100000]' --set exclude_seeds=null "
+             "--set bundled_fraction=0")
 
 
 def retired_message(name: str, field: str = "MODEL") -> str | None:
@@ -68,10 +77,15 @@ def retired_message(name: str, field: str = "MODEL") -> str | None:
     why = RETIRED_AGENTS.get(name)
     if why is None:
         return None
-    return (f"{field} {name!r}: the shipped agent {name!r} was {why}; use general on that "
-            f"object instead (`graspgait evaluate general --object {name}`, `graspgait "
-            f"story general --object {name}`), or train the recipe yourself with "
-            f"`graspgait train {name}` and give its model.zip")
+    if name == "random":  # not a per-object agent: general on the procedural objects
+        instead = (f"use general instead, trained on the same procedural objects "
+                   f"(`graspgait evaluate general --episodes 300 --seed 20000 {_HELD_OUT}` "
+                   f"on held-out ones, `graspgait evaluate general --object FILE` on yours)")
+    else:
+        instead = (f"use general on that object instead (`graspgait evaluate general "
+                   f"--object {name}`, `graspgait story general --object {name}`)")
+    return (f"{field} {name!r}: the shipped agent {name!r} was {why}; {instead}, or train "
+            f"the recipe yourself with `graspgait train {name}` and give its model.zip")
 
 
 def shipped_models_dir() -> Path:

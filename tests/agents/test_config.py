@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from graspgait_env.agents.bench import SHIPPED_AGENTS
 from graspgait_env.agents.config import (
     TrainConfig,
     apply_overrides,
@@ -94,7 +95,7 @@ def test_torch_threads_follow_the_machine():
     assert TrainConfig(torch_threads=3).torch_threads == 3
 
 
-@pytest.mark.parametrize("name", ["circle", "general", "hexagon", "random"])
+@pytest.mark.parametrize("name", SHIPPED_AGENTS)
 def test_each_shipped_model_card_holds_its_bundled_config(name):
     """`graspgait train NAME` trains the shipped model's config: the bundled YAML and the
     config in `agents/models/NAME.json` make the same TrainConfig (a field added after

@@ -88,17 +88,17 @@ def test_evaluate_sampled_actions_stay_one_by_one(smoke_run):
 
 
 def test_one_by_one_gives_the_batched_records_for_an_object_file(tmp_path):
-    """`graspgait evaluate random --object FILE --one-by-one`: the single-env path, the
+    """`graspgait evaluate general --object FILE --one-by-one`: the single-env path, the
     same records as the default batched one on a file the agent never saw."""
     from graspgait_env.cli import main
 
     shape = tmp_path / "kite.yaml"
     shape.write_text("type: polygon\nname: kite\nvertices: [[0.06, 0.0], [0.0, 0.04], "
                      "[-0.05, 0.0], [0.0, -0.04]]\n")
-    fast = evaluate("random", object=str(shape), episodes=6)
-    slow = evaluate("random", object=str(shape), episodes=6, batched=False)
+    fast = evaluate("general", object=str(shape), episodes=6)
+    slow = evaluate("general", object=str(shape), episodes=6, batched=False)
     assert _strip(fast["episodes"]) == _strip(slow["episodes"])
     out = tmp_path / "eval.json"
-    assert main(["evaluate", "random", "--object", str(shape), "--episodes", "2",
+    assert main(["evaluate", "general", "--object", str(shape), "--episodes", "2",
                  "--one-by-one", "--quiet", "--json", str(out)]) == 0
     assert out.is_file()

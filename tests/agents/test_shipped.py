@@ -47,7 +47,7 @@ def test_every_shipped_agent_is_installed_with_both_cards():
             assert (shipped_models_dir() / f"{name}{suffix}").is_file(), name + suffix
     described = dict(describe_shipped())
     assert sorted(described) == sorted(SHIPPED_AGENTS)
-    assert "GraspGaitRandom-v0" in described["random"] and "x the optimum" in described["random"]
+    assert "GraspGaitRandom-v0" in described["general"] and "x the optimum" in described["general"]
 
 
 @pytest.mark.parametrize("name", SHIPPED_AGENTS)
@@ -117,10 +117,15 @@ def test_a_retired_agent_is_not_installed_and_its_name_says_what_replaces_it(nam
             resolve_model(spec)
         msg = str(err.value)
         assert f"MODEL {name!r}: the shipped agent {name!r} was retired after" in msg
-        assert f"graspgait evaluate general --object {name}" in msg
         assert f"graspgait train {name}" in msg
+        if name == "random":  # the generalist: general on procedural objects and files
+            assert "use general instead" in msg and "--object FILE" in msg
+            assert "graspgait evaluate general --episodes 300 --seed 20000" in msg
+        else:
+            assert f"graspgait evaluate general --object {name}" in msg
     # its recipe stays bundled, and a file of that name in the working folder still wins
-    assert load_train_config(name).env_kwargs["object"] == name
+    kw = load_train_config(name).env_kwargs
+    assert kw.get("object", "random") == name and ("level" in kw) == (name == "random")
     monkeypatch.chdir(tmp_path)
     (tmp_path / f"{name}.zip").write_bytes(b"")
     assert resolve_model(name) == Path(f"{name}.zip")
@@ -141,7 +146,7 @@ def test_load_agent_takes_a_name_and_its_zip_loads_without_the_loader():
 
 @pytest.mark.parametrize("name", SHIPPED_AGENTS)
 def test_every_shipped_model_evaluates_on_an_unseen_object_file(name, tmp_path):
-    """Any object file, any friction: the look-ahead of ``random`` included (five
+    """Any object file, any friction: the look-ahead of ``general`` included (eight
     regrasps deep, played in the batched env)."""
     path = tmp_path / "kite.yaml"
     path.write_text(KITE)
@@ -153,8 +158,8 @@ def test_every_shipped_model_evaluates_on_an_unseen_object_file(name, tmp_path):
         assert ep["object"] == "kite" and ep["steps"] >= 1
         if ep["success"]:
             assert ep["solvable"] and ep["regrasps"] >= ep["optimal_regrasps"]
-    if name == "random":
-        assert res["env_kwargs"]["regrasp_lookahead"] == 5
+    if name == "general":
+        assert res["env_kwargs"]["regrasp_lookahead"] == 8
 
 
 # the first 8 moves from reset seeds 0-2 of the ellipse agent shipped with graspgait_env
@@ -225,18 +230,18 @@ def test_import_paths_of_0_1_are_upgraded():
     assert cfg.policy == "graspgait_env.agents.policies:MaskableRegraspScorerPolicy"
 
 
-def test_evaluate_random_on_an_object_file_runs_batched_as_the_single_envs(tmp_path,
-                                                                          monkeypatch):
-    """The look-ahead of ``random`` is batched: evaluation on an object file plays the
+def test_evaluate_general_on_an_object_file_runs_batched_as_the_single_envs(tmp_path,
+                                                                           monkeypatch):
+    """The look-ahead of ``general`` is batched: evaluation on an object file plays the
     episodes side by side, with the records of the single-env loop."""
     import graspgait_env.agents.evaluate as ev
 
     path = tmp_path / "kite.yaml"
     path.write_text(KITE)
-    batched = evaluate("random", object=str(path), episodes=3)
+    batched = evaluate("general", object=str(path), episodes=3)
     calls = []
     monkeypatch.setattr(ev, "batched_eval_env", lambda *a, **k: calls.append(1))  # None
-    serial = evaluate("random", object=str(path), episodes=3)
+    serial = evaluate("general", object=str(path), episodes=3)
     assert calls == [1]
 
     def strip(records):

@@ -27,7 +27,11 @@ def test_policy_names_resolve():
     for bad in ("greedy-reach:0", "greedy-reach:11", "greedy-reach:x"):
         with pytest.raises(GraspGaitInputError, match="depth D of greedy-reach:D is 1 to 10"):
             parse_policy(bad)
-    assert parse_policy("agent:random").kind == "agent"  # the shipped agent, not the policy
+    assert parse_policy("agent:general").kind == "agent"
+    # `random` is the masked random policy; the retired shipped agent of that name says so
+    with pytest.raises(GraspGaitInputError, match=r"'random' was retired after .*use general "
+                       r"instead"):
+        parse_policy("agent:random")
     hexagon = parse_policy("hexagon")
     assert hexagon.kind == "agent" and hexagon.arg.endswith("hexagon.zip")
     for retired in ("ellipse", "agent:pentagon"):  # retired agents: the error says so

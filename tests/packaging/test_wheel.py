@@ -166,7 +166,7 @@ KITE = ("name: kite\ntype: polygon\n"
 
 @pytest.mark.parametrize("argv", [
     ["evaluate", "hexagon", "--episodes", "3"],
-    ["evaluate", "random", "--object", "kite.yaml", "--episodes", "3"],
+    ["evaluate", "general", "--object", "kite.yaml", "--episodes", "3"],
     ["story", "general"],
     ["bench", "--agents", "shipped", "--objects", "pentagon", "--starts", "2"],
     ["evaluate", "--list"],
