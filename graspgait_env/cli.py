@@ -913,7 +913,8 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                                        "evaluate general --object ellipse --episodes 20",
                                        "evaluate general --object my_shape.yaml --mu 0.5",
                                        "evaluate runs/RUN/model.zip --json eval.json",
-                                       "evaluate hexagon --env GraspGaitMujoco-v1 --episodes 5"],
+                                       "evaluate general --object hexagon "
+                                       "--env GraspGaitMujoco-v1 --episodes 5"],
                                       duration="5-60 s for 100 episodes at map level; about "
                                       "2 s per episode on the MuJoCo hand"))
     p.add_argument("model", metavar="MODEL", nargs="?",
@@ -976,7 +977,7 @@ def _add_story(sub: argparse._SubParsersAction) -> None:
                        "plan JSON (replay the learned one on the MuJoCo hand with `graspgait "
                        "simulate OUT/OBJECT_learned_plan.json --video F.mp4`). Exit 1 when the "
                        "agent does not reach the turn. Needs the [train] extra.",
-                       epilog=_epilog(["story", "story hexagon --out story",
+                       epilog=_epilog(["story", "story circle --out story",
                                        "story general --object my_shape.yaml --mu 0.6",
                                        "story general --object ellipse --start 50,270"],
                                       duration="5-20 s"))

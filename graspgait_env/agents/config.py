@@ -243,8 +243,8 @@ class TrainConfig:
     run_root: str = "runs"
     """Folder under which each run gets its own folder."""
     init_model: str | None = None
-    """A saved model (a ``.zip`` path, or a shipped model's name: ``hexagon`` is
-    ``agents/models/hexagon.zip``) whose policy and value weights start this run,
+    """A saved model (a ``.zip`` path, or a shipped model's name: ``circle`` is
+    ``agents/models/circle.zip``) whose policy and value weights start this run,
     or None (a fresh network). Only the weights carry over: the optimizer, the step count and the
     learning-rate schedule start afresh, so a run can continue another under a new reward
     (a curriculum, a fine-tune). The model must have this config's algorithm, observation
@@ -357,7 +357,7 @@ class TrainConfig:
             if not isinstance(self.init_model, (str, os.PathLike)) or not str(self.init_model):
                 raise GraspGaitInputError(f"init_model={self.init_model!r}: must be a saved "
                                           "model's path or a shipped model's name, e.g. "
-                                          "hexagon")
+                                          "circle")
             put("init_model", str(self.init_model))
         put("init_logit_scale", check_number("init_logit_scale", self.init_logit_scale, 0.2,
                                              minimum=0.0, maximum=1.0, strict=True))

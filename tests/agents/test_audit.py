@@ -83,17 +83,20 @@ def test_a_move_into_a_state_without_a_gait_ends_the_pricing(ellipse_env):
 
 
 @pytest.mark.parametrize("start", [(90.0, 274.0), (74.0, 272.0)])
-def test_the_shipped_hexagon_agent_is_optimal_from_the_rule_based_gaits_starts(start):
-    """Measured (agents/models/hexagon.md): from the two starts of seeds 0-99 from which
-    the rule-based method finds a gait under the hand's contact model (fingers 1 and 3),
-    the shipped agent needs the optimum's 19 regrasps, no more than that gait's; the
-    audit finds no losing move. The agent before it needed 21 from 90/274 deg."""
-    from graspgait_env.agents.card import load_agent, shipped_models_dir
+def test_the_shipped_general_agent_is_optimal_from_the_hexagons_rule_based_starts(start):
+    """Measured (2026-12-07): from the two starts of seeds 0-99 of the hexagon at mu 0.7
+    from which the rule-based method finds a gait under the hand's contact model (fingers
+    1 and 3), ``general``, which never saw the hexagon, needs the optimum's 19 regrasps,
+    no more than that gait's; the audit finds no losing move."""
+    from graspgait_env.agents.card import load_agent
     from graspgait_env.agents.envs import make_env
     from graspgait_env.agents.evaluate import agent_predictor
+    from graspgait_env.benchmark.policies import policy_env_kwargs
+    from graspgait_env.benchmark.suite import get_task
 
-    model, card = load_agent(shipped_models_dir() / "hexagon.zip")
-    env = make_env(card["env_id"], card["env_kwargs"])
+    model, card = load_agent("general")
+    env = make_env("GraspGait-v0", policy_env_kwargs(get_task("map-hand-hexagon"),
+                                                     card["env_kwargs"]))
     u = env.unwrapped
     env.reset(seed=0)
     s0 = u.model.start_state({1: start[0], 3: start[1]})

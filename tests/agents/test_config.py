@@ -119,15 +119,15 @@ def test_each_shipped_model_card_holds_its_bundled_config(name):
     assert shipped["env_kwargs"] == shipped["config"]["env_kwargs"]
 
 
-def test_the_shipped_hexagon_is_one_stage_with_the_regrasp_scorer():
-    """The hexagon is trained in one run (no ``init``) with the shared regrasp scorer."""
+def test_the_shipped_general_is_one_stage_with_the_regrasp_scorer():
+    """``general`` is trained in one run (no ``init``) with the shared regrasp scorer."""
     import json
 
     from graspgait_env.agents.card import load_agent, shipped_models_dir
     from graspgait_env.agents.policies import MaskableRegraspScorerPolicy
 
-    card = json.loads((shipped_models_dir() / "hexagon.json").read_text(encoding="utf-8"))
+    card = json.loads((shipped_models_dir() / "general.json").read_text(encoding="utf-8"))
     assert card["config"]["init_model"] is None and "init" not in card
     assert card["config"]["policy"] == "graspgait_env.agents.policies:MaskableRegraspScorerPolicy"
-    model, _ = load_agent(shipped_models_dir() / "hexagon.zip")
+    model, _ = load_agent(shipped_models_dir() / "general.zip")
     assert isinstance(model.policy, MaskableRegraspScorerPolicy)

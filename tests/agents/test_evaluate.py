@@ -90,7 +90,7 @@ def test_optimum_comparison_is_exact_for_the_planners_themselves(ellipse_env):
 def test_a_shipped_agent_never_beats_the_optimum():
     from graspgait_env.agents.bench import shipped_models_dir
 
-    path = shipped_models_dir() / "hexagon.zip"
+    path = shipped_models_dir() / "general.zip"
     assert path.is_file(), f"the shipped model {path} is missing from this install"
     res = evaluate(path, episodes=5, seed=1)
     wins = [ep for ep in res["episodes"] if ep["success"]]

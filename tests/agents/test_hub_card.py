@@ -214,9 +214,9 @@ def test_evaluations_are_rows_with_the_commands_that_made_them(tmp_path, capsys)
 
     assert "| 19.00 (1 start) |" in "\n".join(evaluation_section([part]))
     other = tmp_path / "other.json"
-    other.write_text(json.dumps(dict(res, model={"path": "hexagon"})), encoding="utf-8")
+    other.write_text(json.dumps(dict(res, model={"path": "general"})), encoding="utf-8")
     assert main(["card", "circle", "--evaluation", str(other)]) == 2
-    assert "an evaluation of 'hexagon', not of this card's models" in capsys.readouterr().err
+    assert "an evaluation of 'general', not of this card's models" in capsys.readouterr().err
     del res["command"]
     other.write_text(json.dumps(res), encoding="utf-8")
     assert main(["card", "circle", "--evaluation", str(other)]) == 2

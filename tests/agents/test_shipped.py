@@ -93,16 +93,16 @@ def test_the_circle_cards_measured_row_is_a_fresh_evaluation():
 
 
 def test_shipped_names_resolve_and_unknown_names_list_what_exists(tmp_path, monkeypatch):
-    assert resolve_model("hexagon") == shipped_models_dir() / "hexagon.zip"
-    assert resolve_model("hexagon.zip") == shipped_models_dir() / "hexagon.zip"
+    assert resolve_model("circle") == shipped_models_dir() / "circle.zip"
+    assert resolve_model("circle.zip") == shipped_models_dir() / "circle.zip"
     # a file of that name in the working folder is the user's, and wins
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "hexagon.zip").write_bytes(b"")
-    assert resolve_model("hexagon") == Path("hexagon.zip")
+    (tmp_path / "circle.zip").write_bytes(b"")
+    assert resolve_model("circle") == Path("circle.zip")
     with pytest.raises(GraspGaitInputError) as err:
-        resolve_model("hexagn")
+        resolve_model("circel")
     msg = str(err.value)
-    assert "did you mean 'hexagon'?" in msg and "evaluate --list" in msg
+    assert "did you mean 'circle'?" in msg and "evaluate --list" in msg
     assert ", ".join(sorted(SHIPPED_AGENTS)) in msg
     assert "agents/models" not in msg  # no path that only a clone has
 
@@ -135,11 +135,11 @@ def test_load_agent_takes_a_name_and_its_zip_loads_without_the_loader():
     """The shipped zips name graspgait_env.agents.policies: plain SB3 loads them."""
     from sb3_contrib import MaskablePPO
 
-    model, card = load_agent("hexagon")
+    model, card = load_agent("general")
     assert card["config"]["policy"].startswith("graspgait_env.agents.policies:")
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no "could not deserialize" warning either
-        plain = MaskablePPO.load(shipped_models_dir() / "hexagon.zip", device="cpu")
+        plain = MaskablePPO.load(shipped_models_dir() / "general.zip", device="cpu")
     assert type(plain.policy).__module__ == "graspgait_env.agents.policies"
     assert "agents" not in sys.modules
 

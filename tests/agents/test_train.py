@@ -156,17 +156,17 @@ def test_init_model_starts_from_the_saved_weights_and_states_their_training(tmp_
 def test_init_model_takes_a_shipped_models_name():
     from graspgait_env.agents.card import resolve_model, shipped_models_dir
 
-    assert resolve_model("hexagon") == shipped_models_dir() / "hexagon.zip"
+    assert resolve_model("circle") == shipped_models_dir() / "circle.zip"
     with pytest.raises(GraspGaitInputError, match=r"MODEL 'nope': no such file and no "
-                       r"shipped agent of that name.*hexagon"):
+                       r"shipped agent of that name.*circle, general"):
         resolve_model("nope")
-    cfg = load_train_config("hexagon", ["init_model=hexagon"])
+    cfg = load_train_config("circle", ["init_model=circle"])
     model = build_model(cfg, make_vec_env_for(cfg, n_envs=1))
     init = init_from_model(model, cfg)
-    card = read_card(shipped_models_dir() / "hexagon.zip")
-    assert init == {"model": "hexagon", "steps": card["steps"], "wall_s": card["wall_s"]}
+    card = read_card(shipped_models_dir() / "circle.zip")
+    assert init == {"model": "circle", "steps": card["steps"], "wall_s": card["wall_s"]}
     assert all(torch.equal(p, q) for p, q in zip(
-        model.policy.parameters(), _params(shipped_models_dir() / "hexagon.zip"), strict=True))
+        model.policy.parameters(), _params(shipped_models_dir() / "circle.zip"), strict=True))
 
 
 def test_init_model_refuses_a_model_that_does_not_fit(tmp_path, smoke_run):

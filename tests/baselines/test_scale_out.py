@@ -125,12 +125,12 @@ def test_bench_agents_on_ray_gives_the_serial_rows(local_ray):
     from graspgait_env.agents.bench import find_agents, run_agent_bench
     from graspgait_env.agents.ray_train import bench_agents_on_ray
 
-    agents, _ = find_agents("circle,hexagon")
+    agents, _ = find_agents("circle,general")
     args = (agents, ["hexagon", "circle"], [0.7], 2)
     serial = run_agent_bench(*args, progress=False)
     cases, failures = bench_agents_on_ray(*args, progress=False)
     assert failures == []
-    assert len(serial) == 4  # each agent on its own object, 2 starts
+    assert len(serial) == 6  # circle on its own object, general on both; 2 starts each
     assert [_no_wall(dataclasses.asdict(c)) for c in cases] == [
         _no_wall(dataclasses.asdict(c)) for c in serial]
 
@@ -139,12 +139,12 @@ def test_cli_bench_ray_with_an_agent_writes_the_serial_json(local_ray, tmp_path,
     import json
 
     argv = ["bench", "--objects", "hexagon", "--mus", "0.7", "--planners", "rule",
-            "--starts", "1", "--agents", "hexagon"]
+            "--starts", "1", "--agents", "general"]
     assert main([*argv, "--json", str(tmp_path / "serial.json")]) == 0
     assert main([*argv, "--ray", "--json", str(tmp_path / "ray.json")]) == 0
     capsys.readouterr()
     serial, on_ray = (json.loads((tmp_path / f).read_text()) for f in ("serial.json", "ray.json"))
-    assert any("agent:hexagon" in json.dumps(c) for c in serial["runs"])
+    assert any("agent:general" in json.dumps(c) for c in serial["runs"])
     assert _no_wall(on_ray) == _no_wall(serial)
 
 

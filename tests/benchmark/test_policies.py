@@ -32,15 +32,15 @@ def test_policy_names_resolve():
     with pytest.raises(GraspGaitInputError, match=r"'random' was retired after .*use general "
                        r"instead"):
         parse_policy("agent:random")
-    hexagon = parse_policy("hexagon")
-    assert hexagon.kind == "agent" and hexagon.arg.endswith("hexagon.zip")
-    for retired in ("ellipse", "agent:pentagon"):  # retired agents: the error says so
+    circle = parse_policy("circle")
+    assert circle.kind == "agent" and circle.arg.endswith("circle.zip")
+    for retired in ("ellipse", "agent:pentagon", "hexagon"):  # retired agents: the error says so
         with pytest.raises(GraspGaitInputError, match=r"was retired after .*use general"):
             parse_policy(retired)
     assert parse_policy("config:smoke").label == "config-smoke"
     assert parse_policy("bc").arg == "optimal" and parse_policy("bc:rule").label == "bc-rule"
     with pytest.raises(GraspGaitInputError, match="did you mean"):
-        parse_policy("agent:hexagn")
+        parse_policy("agent:circel")
     with pytest.raises(GraspGaitInputError, match="not a bundled training config"):
         parse_policy("config:nope")
 

@@ -130,7 +130,7 @@ for name in hands:
     load_hand(name, gg.load_object("ellipse"))
 assert bundled_names("sim") == ["default"]
 cfg = load_sim_config()
-model, card = load_agent("hexagon")
+model, card = load_agent("circle")
 assert card["env_id"] == "GraspGait-v0", card
 print("objects", len(names), "hands", len(hands), "agents", ",".join(shipped_agents()))
 """
@@ -165,7 +165,7 @@ KITE = ("name: kite\ntype: polygon\n"
 
 
 @pytest.mark.parametrize("argv", [
-    ["evaluate", "hexagon", "--episodes", "3"],
+    ["evaluate", "circle", "--episodes", "3"],
     ["evaluate", "general", "--object", "kite.yaml", "--episodes", "3"],
     ["story", "general"],
     ["bench", "--agents", "shipped", "--objects", "pentagon", "--starts", "2"],
