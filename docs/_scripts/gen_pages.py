@@ -57,8 +57,8 @@ ARGUMENT_GROUPS: dict[str, tuple[str, ...]] = {
 }
 
 # The opt-in observation fields: the layout part each appends, and the value that
-# turns it on in the tables (the reach look-ahead's depth D = 3, as the shipped
-# `random` agent's)
+# turns it on in the tables (the reach look-ahead's depth D = 3, the env's example
+# value)
 OPT_IN_PARTS: dict[str, tuple[str, Any]] = {
     "lines": ("map_lines", True),
     "lookahead": ("rotation_lookahead", True),

@@ -77,7 +77,7 @@ class ReferenceGaits:
     against the requested one), so it equals ``optimal_gait(model, start,
     turn_deg).regrasps`` (tested) at the cost of one search per model instead of one
     per start (measured: 100 ellipse starts cost 44 s of exact searches one by one;
-    ``graspgait evaluate`` of the shipped hexagon agent, 100 episodes, went from 72 s
+    ``graspgait evaluate`` of the hexagon agent then shipped, 100 episodes, went from 72 s
     to 14 s with the same records).
     """
 
