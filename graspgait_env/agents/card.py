@@ -38,6 +38,7 @@ import yaml
 
 from graspgait_env.agents.legacy import legacy_module_names, upgrade_card
 from graspgait_env.atomic import atomic_write, write_text_atomic
+from graspgait_env.envs.procedural import EVAL_SEEDS
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.extras import require_extra
 
@@ -72,8 +73,18 @@ for ``random``, the generalist trained on the same procedural objects, ``general
 them. Its training config stays bundled (``graspgait train ellipse`` still trains the
 recipe)."""
 
-_HELD_OUT = ("--set 'object_seeds=[1000000,1100000]' --set exclude_seeds=null "
-             "--set bundled_fraction=0")
+_HELD_OUT = (f"--set 'object_seeds=[{EVAL_SEEDS[0]},{EVAL_SEEDS[1]}]' "
+             "--set exclude_seeds=null --set bundled_fraction=0")
+"""The ``--set``s that draw ``GraspGaitRandom-v0``'s objects from its held-out seeds
+alone (:data:`graspgait_env.envs.procedural.EVAL_SEEDS`)."""
+
+_INSTEAD: dict[str, str] = {
+    # not a per-object agent: general on the same procedural objects, or on a file
+    "random": ("use general instead, trained on the same procedural objects (`graspgait "
+               f"evaluate general --episodes 300 --seed 20000 {_HELD_OUT}` on held-out "
+               "ones, `graspgait evaluate general --object FILE` on yours)"),
+}
+"""The replacement of a retired agent that is not ``general`` on its own object."""
 
 
 def retired_message(name: str, field: str = "MODEL") -> str | None:
@@ -82,13 +93,9 @@ def retired_message(name: str, field: str = "MODEL") -> str | None:
     why = RETIRED_AGENTS.get(name)
     if why is None:
         return None
-    if name == "random":  # not a per-object agent: general on the procedural objects
-        instead = (f"use general instead, trained on the same procedural objects "
-                   f"(`graspgait evaluate general --episodes 300 --seed 20000 {_HELD_OUT}` "
-                   f"on held-out ones, `graspgait evaluate general --object FILE` on yours)")
-    else:
-        instead = (f"use general on that object instead (`graspgait evaluate general "
-                   f"--object {name}`, `graspgait story general --object {name}`)")
+    instead = (_INSTEAD[name] if name in _INSTEAD else
+               f"use general on that object instead (`graspgait evaluate general "
+               f"--object {name}`, `graspgait story general --object {name}`)")
     return (f"{field} {name!r}: the shipped agent {name!r} was {why}; {instead}, or train "
             f"the recipe yourself with `graspgait train {name}` and give its model.zip")
 

@@ -152,19 +152,22 @@ def greedy_labels(rank: np.ndarray, masks: np.ndarray, optimal: np.ndarray,
     rotation, else the optimum's set; a row with an empty optimal set stays empty (no
     label).
     """
+    return _greedy_teach(rank, masks, optimal, rotations)[0]
+
+
+def _greedy_teach(rank: np.ndarray, masks: np.ndarray, optimal: np.ndarray,
+                  rotations: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`greedy_labels` and ``(B,)`` its *corrections*: the rows labelled with the
+    optimum's set because the greedy reading's move (its least ``reach_rank`` among the
+    legal moves) is a regrasp outside it."""
     rows = np.arange(len(rank))
-    greedy = _greedy_moves(rank, masks)
-    keep = optimal.any(axis=1) & (optimal[rows, greedy] | (greedy < int(rotations)))
+    greedy = np.where(masks, rank, np.inf).argmin(axis=1)
+    has_set = optimal.any(axis=1)
+    keep = has_set & (optimal[rows, greedy] | (greedy < int(rotations)))
     out = optimal.copy()
     out[keep] = False
     out[rows[keep], greedy[keep]] = True
-    return out
-
-
-def _greedy_moves(rank: np.ndarray, masks: np.ndarray) -> np.ndarray:
-    """``(B,)`` the move each state's greedy reading plays: its least ``reach_rank``
-    among the legal moves."""
-    return np.where(masks, rank, np.inf).argmin(axis=1)
+    return out, has_set & ~keep
 
 
 def _rank_column(obs: Any, venv: Any) -> tuple[int, int]:
@@ -248,10 +251,8 @@ def imitate(model: Any, venv: Any, config: Imitation, *, seed: int = 0,
                 teach = np.stack(venv.env_method("optimal_moves"))
                 weight = np.ones(len(masks))
                 if config.teacher == "greedy":
-                    rank = np.asarray(obs["actions"])[:, :, rank_col]
-                    teach = greedy_labels(rank, masks, teach, rotations)
-                    greedy = _greedy_moves(rank, masks)
-                    fixed = teach.any(axis=1) & ~teach[np.arange(len(masks)), greedy]
+                    teach, fixed = _greedy_teach(np.asarray(obs["actions"])[:, :, rank_col],
+                                                 masks, teach, rotations)
                     weight[fixed] = config.correction_weight
                     corrections += int(fixed.sum())
                 keep = teach.any(axis=1)

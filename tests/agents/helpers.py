@@ -3,6 +3,15 @@
 from __future__ import annotations
 
 
+def kwargs_on_task(card: dict, task_id: str) -> dict:
+    """A model card's env keywords on one benchmark task's problem (a generalist's
+    ``GraspGaitRandom-v0`` keywords dropped), as the benchmark plays it there."""
+    from graspgait_env.benchmark.policies import policy_env_kwargs
+    from graspgait_env.benchmark.suite import get_task
+
+    return policy_env_kwargs(get_task(task_id), card["env_kwargs"])
+
+
 def assert_same_greedy_actions(model, loaded, env, steps: int = 20, seed: int = 3) -> None:
     """``model`` and ``loaded`` pick the same legal deterministic action at each of
     ``steps`` states of ``env``, visited by random legal moves."""

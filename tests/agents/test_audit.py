@@ -11,6 +11,7 @@ from graspgait_env.baselines.policies import PlannerPolicy
 from graspgait_env.gait import GaitState
 from graspgait_env.planners.exact import optimal_gait
 from graspgait_env.planners.rule_based import rule_based
+from tests.agents.helpers import kwargs_on_task
 
 
 @pytest.fixture(scope="module")
@@ -91,12 +92,9 @@ def test_the_shipped_general_agent_is_optimal_from_the_hexagons_rule_based_start
     from graspgait_env.agents.card import load_agent
     from graspgait_env.agents.envs import make_env
     from graspgait_env.agents.evaluate import agent_predictor
-    from graspgait_env.benchmark.policies import policy_env_kwargs
-    from graspgait_env.benchmark.suite import get_task
 
     model, card = load_agent("general")
-    env = make_env("GraspGait-v0", policy_env_kwargs(get_task("map-hand-hexagon"),
-                                                     card["env_kwargs"]))
+    env = make_env("GraspGait-v0", kwargs_on_task(card, "map-hand-hexagon"))
     u = env.unwrapped
     env.reset(seed=0)
     s0 = u.model.start_state({1: start[0], 3: start[1]})

@@ -15,6 +15,7 @@ from graspgait_env.agents.evaluate import (
     run_episodes,
     run_episodes_batched,
 )
+from tests.agents.helpers import kwargs_on_task
 
 
 def _strip(records):
@@ -27,15 +28,13 @@ def test_batched_records_equal_the_serial_ones_for_a_shipped_agent(name):
     (7 episodes in waves of 3) and for ``general``'s look-ahead observation (on the
     hexagon with the hand's contact model, the benchmark's ``map-hand-hexagon``)."""
     from graspgait_env.agents.bench import shipped_models_dir
-    from graspgait_env.benchmark.policies import policy_env_kwargs
-    from graspgait_env.benchmark.suite import get_task
 
     path = shipped_models_dir() / f"{name}.zip"
     assert path.is_file(), f"the shipped model {path} is missing from this install"
     model, card = load_agent(path)
     kwargs = card["env_kwargs"]
     if name == "general":  # trained on GraspGaitRandom-v0: its keywords on one object
-        kwargs = policy_env_kwargs(get_task("map-hand-hexagon"), kwargs)
+        kwargs = kwargs_on_task(card, "map-hand-hexagon")
         assert kwargs["regrasp_lookahead"] == 8 and kwargs["object"] == "hexagon"
     refs = ReferenceGaits()
     serial = run_episodes(agent_predictor(model), make_env("GraspGait-v0", kwargs), 7, 321,
