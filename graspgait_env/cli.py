@@ -936,7 +936,8 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "`graspgait card --evaluation` reads it)")
     p.add_argument("--audit", action="store_true",
                    help="price every move against the optimum: where the regrasps beyond "
-                   "it go (idle regrasps, losing regrasps, losing rotations)")
+                   "it go (idle regrasps, losing regrasps, losing rotations, and how many "
+                   "from states farther from the goal than the look-ahead reads)")
     p.add_argument("--one-by-one", action="store_true",
                    help="play the episodes one by one in the single env, not side by side "
                    "in the batched one (same records; for timing the two)")

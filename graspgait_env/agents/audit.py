@@ -19,6 +19,15 @@ move by move. Three kinds of move carry excess:
 - a **losing rotation**: a rotation with ``G(t) > G(s)`` (a rotation never lowers
   ``G``: it is free, so the optimum from ``s`` could make it).
 
+With a look-ahead of ``D`` regrasps (the env's ``regrasp_lookahead``), the excess of the
+moves made from states with ``G(s) > D`` is also counted apart
+(``excess_beyond_lookahead``): from such a state no chain the look-ahead reads reaches
+the turn, so a policy that reads it cannot tell an optimal regrasp by the goal alone.
+Choice: with ``D = 0`` (no look-ahead) the count is that of every move from a state
+that needs a regrasp; a regrasp wasted where a rotation alone reaches the turn
+(``G(s) = 0``) is never beyond sight, since the env's ``actions`` part says which
+rotations reach it.
+
 A move into a state with no gait left (``G(t) = -1``, e.g. past the turn's window
 backwards) ends the pricing of the episode there (``lost_gait_at``).
 
@@ -35,18 +44,22 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
+
+from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
 
 __all__ = ["audit_moves", "summarize_audits", "AUDIT_KEYS"]
 
 AUDIT_KEYS: tuple[str, ...] = ("excess_regrasps", "idle_regrasps", "losing_regrasps",
                                "excess_of_losing_regrasps", "losing_rotations",
-                               "excess_of_losing_rotations")
+                               "excess_of_losing_rotations", "excess_beyond_lookahead")
 """The counts of :func:`audit_moves` that :func:`summarize_audits` sums."""
 
 
 def audit_moves(model: GaitModel, states: Sequence[GaitState], turn_deg: float,
-                to_go: Callable[[GaitState], int | None]) -> dict[str, Any]:
+                to_go: Callable[[GaitState], int | None], lookahead: int = 0
+                ) -> dict[str, Any]:
     """Price each move of a played gait against the optimum (see the module docstring).
 
     Parameters
@@ -62,6 +75,10 @@ def audit_moves(model: GaitModel, states: Sequence[GaitState], turn_deg: float,
     to_go
         ``to_go(state)``: the optimum's fewest regrasps from ``state``, None where no gait
         exists (:meth:`graspgait_env.agents.evaluate.ReferenceGaits.to_go`).
+    lookahead
+        ``D``, the regrasps the policy's look-ahead reads (the env's
+        ``regrasp_lookahead``; 0: none): the excess of the moves from states with
+        ``G(s) > D`` is summed in ``excess_beyond_lookahead`` as well.
 
     Returns
     -------
@@ -73,6 +90,11 @@ def audit_moves(model: GaitModel, states: Sequence[GaitState], turn_deg: float,
         description, "to": state description, "to_go_before": G(s), "to_go_after":
         G(t)}``, or None.
     """
+    if isinstance(lookahead, bool) or not isinstance(lookahead, (int, np.integer)) \
+            or lookahead < 0:
+        raise GraspGaitInputError(
+            f"lookahead={lookahead!r}: the look-ahead's depth in regrasps, an int >= 0 "
+            "(the env's regrasp_lookahead; 0 for none)")
     K = model.turn_steps(turn_deg)
     sign = 1 if K >= 0 else -1
 
@@ -106,6 +128,8 @@ def audit_moves(model: GaitModel, states: Sequence[GaitState], turn_deg: float,
                 out["losing_rotations"] += 1
                 out["excess_of_losing_rotations"] += excess
             out["excess_regrasps"] += excess
+            if before > lookahead:
+                out["excess_beyond_lookahead"] += excess
             if out["first_loss"] is None:
                 out["first_loss"] = {"move": i, "kind": "regrasp" if regrasp else "rotation",
                                      "from": model.describe_state(s),

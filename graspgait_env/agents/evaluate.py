@@ -244,7 +244,8 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
         Show a tqdm bar.
     audit
         Add ``audit`` to each record: every move priced against the optimum
-        (:func:`graspgait_env.agents.audit.audit_moves`).
+        (:func:`graspgait_env.agents.audit.audit_moves`, with the env's
+        ``regrasp_lookahead`` as the look-ahead, 0 where it has none).
 
     Returns
     -------
@@ -259,6 +260,7 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
     """
     refs = references if references is not None else ReferenceGaits()
     turn = float(env.unwrapped.config.turn_deg)
+    lookahead = int(getattr(env.unwrapped.config, "regrasp_lookahead", 0) or 0)
     out = []
     for i in tqdm(range(episodes), desc=desc, disable=not progress, unit="ep"):
         ep = play_episode(predict, env, seed=seed + i, record_states=audit)
@@ -273,7 +275,8 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
         }
         if audit:
             record["audit"] = audit_moves(model, ep["states"], turn,
-                                          lambda st, m=model: refs.to_go(m, st, turn))
+                                          lambda st, m=model: refs.to_go(m, st, turn),
+                                          lookahead=lookahead)
         out.append(record)
     return out
 
@@ -634,4 +637,6 @@ def _format_audit(a: Mapping[str, Any]) -> str:
     return (f"beyond the optimum ({a['episodes']} successful episodes): "
             f"{a['excess_regrasps']} regrasps = {a['idle_regrasps']} idle regrasps + "
             f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing regrasps + "
-            f"{a['excess_of_losing_rotations']} from {a['losing_rotations']} losing rotations")
+            f"{a['excess_of_losing_rotations']} from {a['losing_rotations']} losing rotations"
+            + (f"; {a['excess_beyond_lookahead']} of them from states farther from the goal "
+               "than the look-ahead reads" if "excess_beyond_lookahead" in a else ""))

@@ -318,7 +318,10 @@ def evaluation_section(results: Sequence[Mapping[str, Any]]) -> list[str]:
                       f"{a['idle_regrasps']} idle regrasps (the goal no closer) + "
                       f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing "
                       f"regrasps + {a['excess_of_losing_rotations']} from "
-                      f"{a['losing_rotations']} losing rotations."]
+                      f"{a['losing_rotations']} losing rotations"
+                      + (f"; {a['excess_beyond_lookahead']} of them from states farther "
+                         "from the goal than the look-ahead reads"
+                         if "excess_beyond_lookahead" in a else "") + "."]
     return lines
 
 

@@ -253,3 +253,23 @@ def test_a_difference_that_rounds_to_zero_reads_plus_zero_points():
     assert _points(0.0) == "+0.0 points"
     assert _points(-0.001) == "-0.1 points"
     assert _points(0.026) == "+2.6 points"
+
+
+def test_the_audit_paragraph_gives_the_excess_beyond_the_lookahead_when_measured():
+    from graspgait_env.agents.hub_card import evaluation_section
+
+    res = {"env_id": "GraspGait-v0", "object": "hexagon", "mu": 0.7, "contact_model": "hand",
+           "n_episodes": 100, "success_rate": 0.68, "success_rate_solvable": 0.932,
+           "solvable_episodes": 73, "mean_regrasps": 24.44, "mean_optimal_regrasps": 24.21,
+           "regrasps_vs_optimal": 1.01, "command": "graspgait evaluate general --audit",
+           "audit": {"episodes": 68, "excess_regrasps": 16, "idle_regrasps": 0,
+                     "losing_regrasps": 8, "excess_of_losing_regrasps": 16,
+                     "losing_rotations": 0, "excess_of_losing_rotations": 0,
+                     "excess_beyond_lookahead": 12}}
+    text = "\n".join(evaluation_section([res]))
+    assert ("0 from 0 losing rotations; 12 of them from states farther from the goal than "
+            "the look-ahead reads.") in text
+    # an audit written before the split was measured says nothing of it (not "0")
+    del res["audit"]["excess_beyond_lookahead"]
+    text = "\n".join(evaluation_section([res]))
+    assert "0 from 0 losing rotations." in text and "look-ahead reads" not in text
