@@ -41,7 +41,7 @@ a state past the turn counts as ``G = 0``.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -49,7 +49,7 @@ import numpy as np
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
 
-__all__ = ["audit_moves", "summarize_audits", "AUDIT_KEYS"]
+__all__ = ["audit_moves", "summarize_audits", "beyond_lookahead_clause", "AUDIT_KEYS"]
 
 AUDIT_KEYS: tuple[str, ...] = ("excess_regrasps", "idle_regrasps", "losing_regrasps",
                                "excess_of_losing_regrasps", "losing_rotations",
@@ -147,3 +147,14 @@ def summarize_audits(audits: Sequence[dict[str, Any]]) -> dict[str, Any]:
     total: dict[str, Any] = {key: sum(int(a[key]) for a in audits) for key in AUDIT_KEYS}
     total["episodes"] = len(audits)
     return total
+
+
+def beyond_lookahead_clause(audit: Mapping[str, Any]) -> str:
+    """The words that ``graspgait evaluate --audit`` and the model card add after the
+    split into kinds: ``"; N of them from states farther from the goal than the
+    look-ahead reads"``, or ``""`` for an audit written before ``excess_beyond_lookahead``
+    was counted (saying nothing rather than 0)."""
+    if "excess_beyond_lookahead" not in audit:
+        return ""
+    return (f"; {audit['excess_beyond_lookahead']} of them from states farther from the goal "
+            "than the look-ahead reads")

@@ -47,7 +47,7 @@ import gymnasium as gym
 import numpy as np
 from tqdm.auto import tqdm
 
-from graspgait_env.agents.audit import audit_moves, summarize_audits
+from graspgait_env.agents.audit import audit_moves, beyond_lookahead_clause, summarize_audits
 from graspgait_env.agents.card import load_agent
 from graspgait_env.agents.envs import contact_model_of, env_kwargs_for, make_env
 from graspgait_env.agents.seeding import seed_everything
@@ -260,7 +260,7 @@ def run_episodes(predict: Callable[[np.ndarray, np.ndarray], int], env: Any, epi
     """
     refs = references if references is not None else ReferenceGaits()
     turn = float(env.unwrapped.config.turn_deg)
-    lookahead = int(getattr(env.unwrapped.config, "regrasp_lookahead", 0) or 0)
+    lookahead = int(env.unwrapped.config.regrasp_lookahead)
     out = []
     for i in tqdm(range(episodes), desc=desc, disable=not progress, unit="ep"):
         ep = play_episode(predict, env, seed=seed + i, record_states=audit)
@@ -638,5 +638,4 @@ def _format_audit(a: Mapping[str, Any]) -> str:
             f"{a['excess_regrasps']} regrasps = {a['idle_regrasps']} idle regrasps + "
             f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing regrasps + "
             f"{a['excess_of_losing_rotations']} from {a['losing_rotations']} losing rotations"
-            + (f"; {a['excess_beyond_lookahead']} of them from states farther from the goal "
-               "than the look-ahead reads" if "excess_beyond_lookahead" in a else ""))
+            f"{beyond_lookahead_clause(a)}")

@@ -56,6 +56,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from graspgait_env.agents.audit import beyond_lookahead_clause
 from graspgait_env.errors import GraspGaitInputError
 
 __all__ = ["METRICS", "benchmark_section", "compare_rows", "evaluation_section", "hub_card",
@@ -318,10 +319,7 @@ def evaluation_section(results: Sequence[Mapping[str, Any]]) -> list[str]:
                       f"{a['idle_regrasps']} idle regrasps (the goal no closer) + "
                       f"{a['excess_of_losing_regrasps']} from {a['losing_regrasps']} losing "
                       f"regrasps + {a['excess_of_losing_rotations']} from "
-                      f"{a['losing_rotations']} losing rotations"
-                      + (f"; {a['excess_beyond_lookahead']} of them from states farther "
-                         "from the goal than the look-ahead reads"
-                         if "excess_beyond_lookahead" in a else "") + "."]
+                      f"{a['losing_rotations']} losing rotations{beyond_lookahead_clause(a)}."]
     return lines
 
 

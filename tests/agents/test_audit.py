@@ -116,6 +116,19 @@ def test_the_excess_beyond_the_lookahead_is_that_of_the_moves_from_farther_state
     # between the two, some of it and not all (else the split would say nothing here)
     assert any(0 < audit_moves(model, states, 360.0, to_go, lookahead=d)[
         "excess_beyond_lookahead"] < sum(price) for d in range(1, G[0]))
+    # run_episodes audits with its env's regrasp_lookahead: the same episode in an env
+    # reading d regrasps deep splits as audit_moves at depth d, not as at depth 0
+    def beyond(depth):
+        return sum(p for p, g in zip(price, G[:-1], strict=True) if g > depth)
+
+    d = next(d for d in range(1, max(G) + 1) if beyond(d) != beyond(0))
+    deep = gym.make("graspgait_env:GraspGait-v0", object="ellipse", mu=0.7,
+                    regrasp_lookahead=d)
+    deep_policy = PlannerPolicy(deep, rule_based)
+    (record,) = run_episodes(lambda obs, mask: int(deep_policy.predict(obs)[0]), deep, 1,
+                             seed=0, audit=True)
+    assert record["regrasps"] == ep["regrasps"]
+    assert record["audit"]["excess_beyond_lookahead"] == beyond(d)
 
 
 @pytest.mark.parametrize("bad", [-1, True, 1.5, "3"])
@@ -131,7 +144,7 @@ def test_the_greedy_readings_excess_lies_beyond_its_lookahead():
     procedural objects (hand contact) wastes 26 regrasps over its 14 successful episodes
     from a start with a gait, every one from a state with more than 2 to go, where no chain
     it reads reaches the turn (within reach, its lexicographic reading plays an optimal
-    regrasp); the audit takes the depth from the env."""
+    regrasp)."""
     from graspgait_env.agents.envs import make_env
     from graspgait_env.benchmark.policies import greedy_reach_predictor
 
