@@ -880,12 +880,13 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
         result = evaluate_on_ray(args.model, env_id=args.env, object=args.object, mu=mu,
                                  episodes=args.episodes, seed=args.seed, env_overrides=env_set,
-                                 address=args.ray, progress=not args.quiet)
+                                 address=args.ray, progress=not args.quiet,
+                                 reading=args.reading)
     else:
         result = evaluate(args.model, env_id=args.env, object=args.object, mu=mu,
                           episodes=args.episodes, seed=args.seed, env_overrides=env_set,
                           progress=not args.quiet, audit=args.audit,
-                          batched=not args.one_by_one)
+                          batched=not args.one_by_one, reading=args.reading)
     print(format_evaluation(result))
     result["command"] = shlex.join(
         [PROG, "evaluate", args.model]
@@ -894,7 +895,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         + (["--mu", f"{mu:g}"] if mu is not None else [])
         + ["--episodes", str(args.episodes)] + (["--seed", str(args.seed)] if args.seed else [])
         + [x for s in args.set or [] for x in ("--set", s)]
-        + (["--audit"] if args.audit else []))
+        + (["--audit"] if args.audit else []) + (["--reading"] if args.reading else []))
     if args.json:
         _write_output("--json", args.json, lambda: write_evaluation(result, args.json))
         print(f"wrote {args.json}")
@@ -913,6 +914,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                                        "evaluate general --object ellipse --episodes 20",
                                        "evaluate general --object my_shape.yaml --mu 0.5",
                                        "evaluate runs/RUN/model.zip --json eval.json",
+                                       "evaluate general --object hexagon --reading",
                                        "evaluate general --object hexagon "
                                        "--env GraspGaitMujoco-v1 --episodes 5"],
                                       duration="5-60 s for 100 episodes at map level; about "
@@ -938,6 +940,11 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    help="price every move against the optimum: where the regrasps beyond "
                    "it go (idle regrasps, losing regrasps, losing rotations, and how many "
                    "from states farther from the goal than the look-ahead reads)")
+    p.add_argument("--reading", action="store_true",
+                   help="also play the greedy reading of the model's own look-ahead (no "
+                   "learning: the move its reach look-ahead ranks first) from the same "
+                   "starts, and compare the two start by start; for models trained with "
+                   "regrasp_lookahead (general)")
     p.add_argument("--one-by-one", action="store_true",
                    help="play the episodes one by one in the single env, not side by side "
                    "in the batched one (same records; for timing the two)")

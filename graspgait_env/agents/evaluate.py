@@ -53,13 +53,14 @@ from graspgait_env.agents.envs import contact_model_of, env_kwargs_for, make_env
 from graspgait_env.agents.seeding import seed_everything
 from graspgait_env.atomic import json_ready, write_text_atomic
 from graspgait_env.envs.config import check_count, check_mu, check_object
+from graspgait_env.envs.reading import greedy_reading, greedy_reading_batch
 from graspgait_env.envs.registration import ENV_IDS
 from graspgait_env.errors import GraspGaitInputError
 from graspgait_env.gait import GaitModel, GaitState
 
 __all__ = ["ReferenceGaits", "evaluate", "play_episode", "run_episodes", "run_episodes_batched",
            "batched_eval_env", "summarize_episodes", "write_evaluation", "EVAL_SEED",
-           "EVAL_BATCH", "agent_predictor", "agent_batch_predictor"]
+           "EVAL_BATCH", "agent_predictor", "agent_batch_predictor", "compare_with_reading"]
 
 EVAL_SEED = 10_000  # first reset seed of training's periodic evaluation (fixed starts)
 EVAL_BATCH = 100  # episodes played side by side by run_episodes_batched
@@ -483,7 +484,7 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
              object: Any = None, mu: float | None = None, episodes: int = 100, seed: int = 0,
              deterministic: bool = True, env_overrides: Mapping[str, Any] | None = None,
              progress: bool = False, audit: bool = False,
-             batched: bool = True) -> dict[str, Any]:
+             batched: bool = True, reading: bool = False) -> dict[str, Any]:
     """Evaluate a saved agent (``model.zip``) and compare it with the optimum and the rules.
 
     Parameters
@@ -525,6 +526,12 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         (:func:`batched_eval_env`; one policy call per step for up to
         :data:`EVAL_BATCH` episodes); False plays them one by one in the single env.
         The records are the same either way (tested); only the wall time differs.
+    reading
+        Also play the greedy reading of the model's own reach look-ahead
+        (:func:`graspgait_env.envs.reading.greedy_reading`: no learning, the least
+        ``reach_rank``) from the same starts in the same env, and compare it with the
+        model start by start (:func:`compare_with_reading`); needs a model trained with
+        ``regrasp_lookahead``. With ``audit``, its moves are audited too.
 
     Returns
     -------
@@ -532,7 +539,8 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         The aggregate numbers of :func:`summarize_episodes`, the per-episode records
         under ``episodes``, and ``model`` (path, algo, card), ``env_id``, ``env_kwargs``,
         ``object``, ``mu`` (None when drawn per episode), ``contact_model``, ``seed``,
-        ``deterministic``, ``wall_s``; with ``audit``, ``audit``.
+        ``deterministic``, ``wall_s``; with ``audit``, ``audit``; with ``reading``,
+        ``reading`` (:func:`compare_with_reading`).
 
     Raises
     ------
@@ -559,7 +567,13 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
                             contact_model=card.get("contact_model"))
     kwargs.update(env_overrides or {})
     env = make_env(env_id, kwargs, card.get("wrappers") or ())
+    refs = ReferenceGaits()
     try:
+        if reading and not int(env.unwrapped.config.regrasp_lookahead):
+            raise GraspGaitInputError(
+                f"reading: model {str(model_path)!r} reads no reach look-ahead "
+                "(regrasp_lookahead 0 in its card), so it has no greedy reading to compare "
+                "with; drop --reading, or evaluate a model trained with regrasp_lookahead")
         if _shapes(env.observation_space) != _shapes(model.observation_space):
             raise GraspGaitInputError(
                 f"model {str(model_path)!r}: observes {_shapes(model.observation_space)}, "
@@ -572,12 +586,22 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         if venv is not None:  # the same episodes side by side: one policy call per step
             try:
                 records = run_episodes_batched(agent_batch_predictor(model), venv, episodes,
-                                               seed, progress=progress)
+                                               seed, references=refs, progress=progress)
+                if reading and env.unwrapped.config.observation_mode == "box":
+                    read = _reading_alone(env_id, kwargs, card.get("wrappers") or (),
+                                          episodes, seed, refs, progress, audit)
+                elif reading:  # reach_rank in every row: the reading side by side too
+                    read = run_episodes_batched(greedy_reading_batch(env), venv, episodes,
+                                                seed, references=refs, progress=progress,
+                                                desc="greedy reading")
             finally:
                 venv.close()
         else:
             records = run_episodes(agent_predictor(model, deterministic), env, episodes,
-                                   seed, progress=progress, audit=audit)
+                                   seed, references=refs, progress=progress, audit=audit)
+            if reading:
+                read = _reading_alone(env_id, kwargs, card.get("wrappers") or (), episodes,
+                                      seed, refs, progress, audit)
         contact_model = contact_model_of(env)
     finally:
         env.close()
@@ -602,7 +626,72 @@ def evaluate(model_path: str | os.PathLike[str], *, env_id: str | None = None,
         "deterministic": bool(deterministic),
         "wall_s": time.perf_counter() - t0,
         "episodes": records,
+        **({"reading": compare_with_reading(records, read, kwargs["regrasp_lookahead"],
+                                            audit=audit)} if reading else {}),
     }
+
+
+def _reading_alone(env_id: str, kwargs: Mapping[str, Any], wrappers: Any, episodes: int,
+                   seed: int, refs: ReferenceGaits, progress: bool, audit: bool
+                   ) -> list[dict[str, Any]]:
+    """The greedy reading's records, one episode at a time, in a fresh env of the model's
+    settings (so its episode ``i`` starts where the model's did)."""
+    env = make_env(env_id, kwargs, wrappers)
+    try:
+        return run_episodes(greedy_reading(env), env, episodes, seed, references=refs,
+                            progress=progress, desc="greedy reading", audit=audit)
+    finally:
+        env.close()
+
+
+def compare_with_reading(records: list[dict[str, Any]], reading: list[dict[str, Any]],
+                         depth: int, audit: bool = False) -> dict[str, Any]:
+    """The greedy reading's episodes beside the model's, from the same starts.
+
+    Parameters
+    ----------
+    records, reading
+        :func:`run_episodes` records of the model and of the greedy reading, episode
+        ``i`` of each from the same reset seed (checked: the same object, ``mu`` and start
+        grasp, else ``RuntimeError``).
+    depth
+        The look-ahead's depth (regrasps), reported.
+    audit
+        The reading's records carry ``audit``: sum it as :func:`evaluate` does.
+
+    Returns
+    -------
+    dict
+        :func:`summarize_episodes` of the reading; ``depth``; over the solvable starts,
+        ``both_succeeded`` (starts both turned), ``model_fewer``, ``model_more`` and
+        ``same`` (of those, where the model spent fewer, more or as many regrasps),
+        ``model_regrasps`` and ``reading_regrasps`` (their totals there),
+        ``only_model`` and ``only_reading`` (starts only one of them turned); the
+        reading's records under ``episodes``; with ``audit``, ``audit``.
+    """
+    if len(records) != len(reading):
+        raise RuntimeError(f"{len(records)} model episodes against {len(reading)} of the "
+                           "greedy reading: they must be played from the same starts")
+    for i, (a, b) in enumerate(zip(records, reading, strict=True)):
+        if (a["object"], a["mu"], a["start"]) != (b["object"], b["mu"], b["start"]):
+            raise RuntimeError(f"episode {i}: the model started from {a['object']} "
+                               f"{a['start']} (mu {a['mu']}), the greedy reading from "
+                               f"{b['object']} {b['start']} (mu {b['mu']}): not the same start")
+    pairs = [(a, b) for a, b in zip(records, reading, strict=True) if a["solvable"]]
+    both = [(a["regrasps"], b["regrasps"]) for a, b in pairs if a["success"] and b["success"]]
+    out = {
+        **summarize_episodes(reading), "depth": int(depth), "both_succeeded": len(both),
+        "model_fewer": sum(x < y for x, y in both), "model_more": sum(x > y for x, y in both),
+        "same": sum(x == y for x, y in both), "model_regrasps": sum(x for x, _ in both),
+        "reading_regrasps": sum(y for _, y in both),
+        "only_model": sum(a["success"] and not b["success"] for a, b in pairs),
+        "only_reading": sum(b["success"] and not a["success"] for a, b in pairs),
+        "episodes": reading,
+    }
+    if audit:
+        out["audit"] = summarize_audits([r["audit"] for r in reading
+                                         if r["success"] and r["solvable"]])
+    return out
 
 
 def write_evaluation(result: Mapping[str, Any], path: str | os.PathLike[str]) -> Path:
@@ -628,9 +717,28 @@ def format_evaluation(result: Mapping[str, Any]) -> str:
         f"rule-based {f(result['mean_rule_regrasps'])} "
         f"(agent/rule x{f(result['regrasps_vs_rule'], '.3f')})",
         *([_format_audit(result["audit"])] if result.get("audit") else []),
+        *(_format_reading(result["reading"], result) if result.get("reading") else []),
         f"illegal actions {f(result['illegal_action_rate'], '.1%')}; "
         f"wall time {result['wall_s']:.1f} s",
     ])
+
+
+def _format_reading(r: Mapping[str, Any], result: Mapping[str, Any]) -> list[str]:
+    def f(x: Any, spec: str) -> str:
+        return "-" if x is None else format(x, spec)
+
+    lines = [
+        f"greedy reading of the look-ahead ({r['depth']} regrasps deep), same starts: "
+        f"{f(r['success_rate_solvable'], '.1%')} of the {r['solvable_episodes']} starts with "
+        f"a gait; regrasps x{f(r['regrasps_vs_optimal'], '.3f')} the optimum (agent "
+        f"x{f(result['regrasps_vs_optimal'], '.3f')})",
+        f"agent against the reading: of the {r['both_succeeded']} starts both turned, fewer "
+        f"regrasps from {r['model_fewer']}, more from {r['model_more']}, as many from "
+        f"{r['same']} ({r['model_regrasps']} against {r['reading_regrasps']} in all); only the "
+        f"agent turned {r['only_model']}, only the reading {r['only_reading']}"]
+    if r.get("audit"):
+        lines.append("reading " + _format_audit(r["audit"]))
+    return lines
 
 
 def _format_audit(a: Mapping[str, Any]) -> str:

@@ -188,7 +188,7 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
         The Ray cluster (None: a local Ray).
     **kwargs
         Further keyword arguments of ``evaluate`` (``env_id``, ``object``, ``mu``,
-        ``deterministic``, ``env_overrides``).
+        ``deterministic``, ``env_overrides``, ``reading``).
 
     Returns
     -------
@@ -204,7 +204,7 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
     """
     import time
 
-    from graspgait_env.agents.evaluate import evaluate, summarize_episodes
+    from graspgait_env.agents.evaluate import compare_with_reading, evaluate, summarize_episodes
     from graspgait_env.baselines.scale_out import ray_session, run_tasks
     from graspgait_env.envs.config import check_count
 
@@ -242,6 +242,10 @@ def evaluate_on_ray(model_path: str | os.PathLike[str], *, episodes: int = 100, 
     out.update({"object": objects[0] if len(objects) == 1 else None,
                 "mu": mus[0] if len(mus) == 1 else None, "seed": seed,
                 "wall_s": time.perf_counter() - t0, "episodes": records})
+    if kwargs.get("reading"):  # the reading's records in seed order, compared once
+        out["reading"] = compare_with_reading(
+            records, [r for part in parts for r in part["reading"]["episodes"]],
+            parts[0]["reading"]["depth"])
     return out
 
 

@@ -338,35 +338,17 @@ def _planner_predictor(name: str) -> Callable[[gym.Env], Predict]:
 
 def greedy_reach_predictor(env: gym.Env, depth: int = GREEDY_REACH_DEPTH) -> Predict:
     """The greedy reading of the reach look-ahead (module docstring) for an env made with
-    ``regrasp_lookahead=depth`` (box observation): a rotation that completes the turn
-    when one is legal, else the legal move whose shortfall is least at depth ``depth -
-    1``, then ``depth - 2``, ... (ties: a regrasp before a rotation, a shorter rotation
-    first), the order of :func:`graspgait_env.envs.observation.greedy_ranks`, which also
-    writes the dict observation's ``reach_rank``."""
-    from graspgait_env.envs.observation import greedy_ranks
+    ``regrasp_lookahead=depth``: :func:`graspgait_env.envs.reading.greedy_reading`, the
+    order of :func:`graspgait_env.envs.observation.greedy_ranks`, which also writes the
+    dict observation's ``reach_rank``. An env that reads another depth is refused."""
+    from graspgait_env.envs.reading import greedy_reading
 
-    u = env.unwrapped
-    D = int(depth)
-
-    def predict(obs: np.ndarray, mask: np.ndarray) -> int:
-        model, lay = u.model, u.layout
-        R2, P2 = 2 * model.R, 2 * model.P
-        legal = np.asarray(mask, dtype=bool)
-        if not legal.any():
-            return 0
-        box = np.asarray(obs)
-        keys = box[lay.reach].reshape(P2 + R2, D)
-        reach = np.concatenate((keys[P2:], keys[:P2]))[None]  # the action order
-        K = abs(model.turn_steps(u.config.turn_deg))
-        sign = 1 if u.config.turn_deg > 0 else -1
-        delta = np.asarray(u._rot_delta, dtype=np.int64)
-        finishing = np.zeros((1, R2 + P2), dtype=bool)
-        finishing[0, :R2] = legal[:R2] & (float(box[lay.achieved]) * K + sign * delta
-                                          >= K - 0.5)
-        none = int(round(float(u.box_space.high[lay.reach.start]) * K))
-        ranks = greedy_ranks(reach, finishing, legal[None], delta, K, none)
-        return int(np.argmin(ranks[0]))
-    return predict
+    have = int(env.unwrapped.config.regrasp_lookahead)
+    if have != int(depth):
+        raise GraspGaitInputError(
+            f"greedy-reach:{int(depth)}: the env reads regrasp_lookahead={have}; make it "
+            f"with regrasp_lookahead={int(depth)}")
+    return greedy_reading(env)
 
 
 def _agent_policy(model_path: str, info: dict[str, Any] | None = None) -> CellPolicy:
