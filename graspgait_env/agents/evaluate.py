@@ -699,11 +699,14 @@ def write_evaluation(result: Mapping[str, Any], path: str | os.PathLike[str]) ->
     return write_text_atomic(path, json.dumps(json_ready(result), indent=1) + "\n")
 
 
+def _fmt(x: Any, spec: str = ".2f") -> str:
+    """``x`` formatted by ``spec``, or ``-`` where it is ``None`` (a figure with no episodes)."""
+    return "-" if x is None else format(x, spec)
+
+
 def format_evaluation(result: Mapping[str, Any]) -> str:
     """A few lines for the terminal: success rates and regrasps beside the references."""
-    def f(x: Any, spec: str = ".2f") -> str:
-        return "-" if x is None else format(x, spec)
-
+    f = _fmt
     where = (f"{result['env_id']}, object {result['object'] or 'per episode'}, "
              f"mu {f(result['mu'], 'g') if result['mu'] is not None else 'per episode'}, "
              f"contact model {result['contact_model']}")
@@ -724,9 +727,7 @@ def format_evaluation(result: Mapping[str, Any]) -> str:
 
 
 def _format_reading(r: Mapping[str, Any], result: Mapping[str, Any]) -> list[str]:
-    def f(x: Any, spec: str) -> str:
-        return "-" if x is None else format(x, spec)
-
+    f = _fmt
     lines = [
         f"greedy reading of the look-ahead ({r['depth']} regrasps deep), same starts: "
         f"{f(r['success_rate_solvable'], '.1%')} of the {r['solvable_episodes']} starts with "
