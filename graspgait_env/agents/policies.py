@@ -473,9 +473,9 @@ class PartsExtractor(BaseFeaturesExtractor):
     The features are the **global context** (``grasp``, the ``legal`` column of
     ``actions``, the ``window`` and ``lines`` parts flattened, and each feature column's
     least and greatest value over the legal moves: what the best move offers), then the
-    **action block**: per action, its ``F`` features and, with ``relative``, each less its
-    least over the legal moves (0 for an illegal move), so that a shared scorer sees how
-    a move compares with the others. The policy keeps the block out of its MLPs and scores
+    **action block**: per action, its ``F`` features and each less its least over the
+    legal moves (0 for an illegal move), so that a shared scorer sees how a move compares
+    with the others. The policy keeps the block out of its MLPs and scores
     every action from its row of it with one network
     (:class:`MaskableRegraspScorerPolicy`).
 
@@ -483,16 +483,13 @@ class PartsExtractor(BaseFeaturesExtractor):
     ----------
     observation_space
         The env's ``Dict`` observation space (SB3 passes it).
-    relative
-        Add each feature less its least over the legal moves to the block (default True).
     extremes
         Add, per feature, 1 for the legal moves at its least and 1 for those at its
         greatest value (two one-hot codes of ``F`` entries each; default False): which
         moves are the best by each feature, whichever way is better.
     """
 
-    def __init__(self, observation_space: gym.spaces.Dict, relative: bool = True,
-                 extremes: bool = False) -> None:
+    def __init__(self, observation_space: gym.spaces.Dict, extremes: bool = False) -> None:
         from graspgait_env.envs.observation import ACTION_FEATURES
 
         names = list(getattr(observation_space, "spaces", {}) or {})
@@ -503,12 +500,11 @@ class PartsExtractor(BaseFeaturesExtractor):
                 "parts (grasp, actions, window); set env_kwargs observation_mode: dict")
         n_actions, n_features = observation_space["actions"].shape
         self.legal = ACTION_FEATURES.index("legal")
-        self.relative = bool(relative)
         self.extremes = bool(extremes)
         self.names = [k for k in ("window", "lines") if k in names]
         flat = sum(math.prod(observation_space[k].shape) for k in self.names)
         width = int(observation_space["grasp"].shape[0]) + n_actions + flat + 2 * n_features
-        self.block_channels = n_features * (1 + self.relative + 2 * self.extremes)
+        self.block_channels = n_features * (2 + 2 * self.extremes)
         super().__init__(observation_space, width + n_actions * self.block_channels)
         #: the scored block: where it starts in the features and the actions it scores
         self.block_start = width
@@ -527,10 +523,8 @@ class PartsExtractor(BaseFeaturesExtractor):
         parts = [observations["grasp"], act[:, :, self.legal]]
         parts += [observations[k].reshape(b, -1) for k in self.names]
         parts += [lo, hi]
-        block = [act]
         on = legal[:, :, None].to(act.dtype)
-        if self.relative:
-            block.append((act - lo[:, None, :]) * on)
+        block = [act, (act - lo[:, None, :]) * on]
         if self.extremes:  # 1e-6: the features are exact multiples of 1 / K or 0 / 1
             block.append((act <= lo[:, None, :] + 1e-6).to(act.dtype) * on)
             block.append((act >= hi[:, None, :] - 1e-6).to(act.dtype) * on)

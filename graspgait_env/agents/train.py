@@ -185,7 +185,9 @@ def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
     GraspGaitInputError
         ``features_extractor`` is the retired
         :class:`~graspgait_env.agents.policies.GraspMapExtractor` (it only loads models
-        saved with it); the message names the named-parts design that replaces it.
+        saved with it); the message names the named-parts design that replaces it. Or a
+        key of ``features_extractor_kwargs`` is not a keyword of the extractor (the
+        message names those it takes).
     """
     from graspgait_env.agents.policies import GraspMapExtractor
 
@@ -201,24 +203,41 @@ def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
             "graspgait_env.agents.policies:PartsExtractor, policy: "
             "graspgait_env.agents.policies:MaskableRegraspScorerPolicy, as the bundled "
             "config general does (graspgait config train general)")
+    names = _keywords_of(extractor) - {"observation_space"}
+    unknown = sorted(set(kwargs) - names)
+    if unknown:
+        raise GraspGaitInputError(
+            f"features_extractor_kwargs {unknown}: not keywords of features_extractor "
+            f"{config.features_extractor!r}; it takes {sorted(names)}")
     return kwargs
+
+
+def _keywords_of(cls: Any) -> set[str]:
+    """The keyword arguments ``cls(...)`` takes by name: those of each ``__init__`` along
+    its MRO, down to the first that passes no ``**kwargs`` on (none where ``cls`` is not a
+    class)."""
+    import inspect
+
+    names: set[str] = set()
+    for klass in inspect.getmro(cls) if isinstance(cls, type) else ():
+        if "__init__" in vars(klass):
+            params = inspect.signature(klass.__init__).parameters.values()
+            names |= {p.name for p in params
+                      if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+            if not any(p.kind is p.VAR_KEYWORD for p in params):
+                break
+    return names - {"self"}
 
 
 def _check_policy_kwargs(config: TrainConfig, policy: Any) -> None:
     """Refuse a ``policy_kwargs`` key the policy class does not take, naming those it does
     (SB3 would raise a bare ``TypeError`` deep in the model's construction)."""
-    import inspect
-
     if not config.policy_kwargs:
         return
     cls = (_algo_class(config.algo).policy_aliases.get(policy) if isinstance(policy, str)
            else policy)
-    names: set[str] = set()
-    for klass in inspect.getmro(cls) if isinstance(cls, type) else ():
-        if "__init__" in vars(klass):
-            names |= {n for n, p in inspect.signature(klass.__init__).parameters.items()
-                      if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
-    names -= {"self", "observation_space", "action_space", "lr_schedule", *OWN_POLICY_KWARGS}
+    names = _keywords_of(cls) - {"observation_space", "action_space", "lr_schedule",
+                                 *OWN_POLICY_KWARGS}
     unknown = sorted(set(config.policy_kwargs) - names)
     if unknown:
         raise GraspGaitInputError(

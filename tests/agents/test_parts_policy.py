@@ -55,16 +55,17 @@ def test_features_are_the_parts_and_each_move_against_the_best_legal_one():
 
 def test_extremes_mark_the_best_legal_moves_by_each_feature():
     env = _env(regrasp_lookahead=2)
-    ext = PartsExtractor(env.observation_space, relative=False, extremes=True)
+    ext = PartsExtractor(env.observation_space, extremes=True)
     A, F = env.observation_space["actions"].shape
-    assert ext.block_channels == 3 * F
+    assert ext.block_channels == 4 * F
     obs, info = env.reset(seed=2)
     t = {k: torch.as_tensor(v[None]) for k, v in obs.items()}
-    block = ext(t)[0, ext.block_start:].numpy().reshape(A, 3 * F)
+    block = ext(t)[0, ext.block_start:].numpy().reshape(A, 4 * F)
     act, legal = obs["actions"], info["action_mask"]
     lo, hi = act[legal].min(axis=0), act[legal].max(axis=0)
-    np.testing.assert_array_equal(block[:, F:2 * F], (act == lo) & legal[:, None])
-    np.testing.assert_array_equal(block[:, 2 * F:], (act == hi) & legal[:, None])
+    np.testing.assert_allclose(block[:, F:2 * F], (act - lo) * legal[:, None], atol=1e-6)
+    np.testing.assert_array_equal(block[:, 2 * F:3 * F], (act == lo) & legal[:, None])
+    np.testing.assert_array_equal(block[:, 3 * F:], (act == hi) & legal[:, None])
 
 
 def test_a_box_observation_is_refused_with_the_fix():
@@ -155,3 +156,15 @@ def test_bad_policy_kwargs_name_the_field_and_the_fix(tmp_path):
                                         "policy_kwargs={linear_head: false}"])
     with pytest.raises(GraspGaitInputError, match=r"not keywords of policy 'MlpPolicy'"):
         build_model(plain, make_vec_env_for(plain))
+
+
+def test_an_unknown_extractor_keyword_names_those_it_takes(tmp_path):
+    # `relative` was a switch of PartsExtractor (always on in every config); it is gone
+    cfg = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                      "features_extractor_kwargs={relative: false}"])
+    with pytest.raises(GraspGaitInputError, match=r"features_extractor_kwargs \['relative'\]: "
+                       r"not keywords of features_extractor .*PartsExtractor.*'extremes'"):
+        build_model(cfg, make_vec_env_for(cfg))
+    ok = load_train_config("smoke", [f"run_root={tmp_path}", *_PARTS,
+                                     "features_extractor_kwargs={extremes: true}"])
+    assert build_model(ok, make_vec_env_for(ok)).policy.features_extractor.extremes
