@@ -203,12 +203,9 @@ def extractor_kwargs(config: TrainConfig) -> dict[str, Any]:
             "graspgait_env.agents.policies:PartsExtractor, policy: "
             "graspgait_env.agents.policies:MaskableRegraspScorerPolicy, as the bundled "
             "config general does (graspgait config train general)")
-    names = _keywords_of(extractor) - {"observation_space"}
-    unknown = sorted(set(kwargs) - names)
-    if unknown:
-        raise GraspGaitInputError(
-            f"features_extractor_kwargs {unknown}: not keywords of features_extractor "
-            f"{config.features_extractor!r}; it takes {sorted(names)}")
+    _refuse_unknown_keys("features_extractor_kwargs", kwargs, "features_extractor",
+                         config.features_extractor,
+                         _keywords_of(extractor) - {"observation_space"})
     return kwargs
 
 
@@ -229,6 +226,16 @@ def _keywords_of(cls: Any) -> set[str]:
     return names - {"self"}
 
 
+def _refuse_unknown_keys(field: str, given: Any, owner: str, name: Any,
+                         names: set[str]) -> None:
+    """Raise naming the keys of ``given`` (the config's ``field``) outside ``names``, the
+    keywords of the config's ``owner`` ``name``, and those it takes."""
+    unknown = sorted(set(given) - names)
+    if unknown:
+        raise GraspGaitInputError(f"{field} {unknown}: not keywords of {owner} {name!r}; "
+                                  f"it takes {sorted(names)}")
+
+
 def _check_policy_kwargs(config: TrainConfig, policy: Any) -> None:
     """Refuse a ``policy_kwargs`` key the policy class does not take, naming those it does
     (SB3 would raise a bare ``TypeError`` deep in the model's construction)."""
@@ -236,13 +243,9 @@ def _check_policy_kwargs(config: TrainConfig, policy: Any) -> None:
         return
     cls = (_algo_class(config.algo).policy_aliases.get(policy) if isinstance(policy, str)
            else policy)
-    names = _keywords_of(cls) - {"observation_space", "action_space", "lr_schedule",
-                                 *OWN_POLICY_KWARGS}
-    unknown = sorted(set(config.policy_kwargs) - names)
-    if unknown:
-        raise GraspGaitInputError(
-            f"policy_kwargs {unknown}: not keywords of policy {config.policy!r}; it takes "
-            f"{sorted(names)}")
+    _refuse_unknown_keys("policy_kwargs", config.policy_kwargs, "policy", config.policy,
+                         _keywords_of(cls) - {"observation_space", "action_space",
+                                              "lr_schedule", *OWN_POLICY_KWARGS})
 
 
 def build_model(config: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
