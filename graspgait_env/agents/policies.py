@@ -486,7 +486,10 @@ class PartsExtractor(BaseFeaturesExtractor):
     extremes
         Add, per feature, 1 for the legal moves at its least and 1 for those at its
         greatest value (two one-hot codes of ``F`` entries each; default False): which
-        moves are the best by each feature, whichever way is better.
+        moves are the best by each feature, whichever way is better. ``general`` sets it:
+        without it, over seeds 0-4, the recipe spends 1.030x the optimum's regrasps at
+        mu 0.5 on held-out objects against 1.019x (IQM; docs/agents.md). The default
+        stays False so that a model saved without the keyword loads as it was trained.
     """
 
     def __init__(self, observation_space: gym.spaces.Dict, extremes: bool = False) -> None:
